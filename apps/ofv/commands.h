@@ -1,0 +1,22 @@
+// The `ofv` command line: one function per subcommand.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace ofv::cli {
+
+/// Exit codes shared by every subcommand.
+enum ExitCode : int { kOk = 0, kRuntimeFailure = 1, kUsage = 2 };
+
+/// A registered subcommand and its body, run after parsing; returns an ExitCode.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+/// Registers `ofv estimate` on the app.
+Command add_estimate_command(CLI::App& app);
+
+}  // namespace ofv::cli

@@ -1,0 +1,34 @@
+// ofv: occlusion-free view estimation and visual servoing.
+#include "commands.h"
+
+#include <iostream>
+#include <vector>
+
+int main(int argc, char** argv) {
+  using namespace ofv::cli;
+  CLI::App app{
+      "ofv - occlusion-free view: keep a target object in clear view of an eye-in-hand RGB-D\n"
+      "camera (Cuiral-Zueco & Lopez-Nicolas, \"Dynamic Occlusion Handling for Real Time\n"
+      "Object Perception\"). Run 'ofv COMMAND --help' for a command's options."};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Print the help of every command");
+
+  const std::vector<Command> commands{add_estimate_command(app)};
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "ofv: " << e.what() << " (see 'ofv --help')\n";
+    return kUsage;
+  }
+  for (const Command& command : commands) {
+    if (command.app->parsed()) {
+      return command.run();
+    }
+  }
+  return kUsage;
+}

@@ -1,0 +1,194 @@
+/**
+ * \file estimator.h
+ * \brief The occlusion-free view estimator of Cuiral-Zueco and López-Nicolás,
+ *        "Dynamic Occlusion Handling for Real Time Object Perception",
+ *        section III, as fixed by ESTIMATOR-SPEC.md.
+ *
+ * Pure geometry on Eigen: no I/O, no PCL, no ViSP. Every vector is in one
+ * fixed frame (the world frame W), in metres.
+ *
+ * \code
+ * ofv::ViewProblem problem;
+ * problem.positions = ...;   // 3 x N supervoxel centroids v_n
+ * problem.normals = ...;     // 3 x N normals p_n, towards the sensor side
+ * problem.occluders = ...;   // 3 x B occluder points q_b
+ * const ofv::ViewEstimate estimate = ofv::estimate_view(problem, ofv::EstimatorSettings{});
+ * // estimate.tf: camera position on the sphere, looking at estimate.centroid
+ * \endcode
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief How the initial view t0 averages the normals-to-sphere rays (spec §2).
+enum class InitialView {
+  SphericalMean,  ///< circular means of polar angle and azimuth about e1 (paper eqs. 4-5)
+  VectorMean,     ///< normalised sum of the unit rays
+};
+
+/// \brief How the projected occlusion points push the iterate (spec §4).
+enum class PushWeighting {
+  Sum,              ///< v = sum (t_i - d_pi), the paper's reading
+  InverseDistance,  ///< each term divided by its squared length: near points push hardest
+};
+
+/// \brief A named set of settings (spec §4, `preset`).
+enum class Preset {
+  Paper,        ///< the paper's printed reading
+  AuthorsCode,  ///< the authors' public 2020 implementation: step r_seed/2, clearance 2 r_seed, 50 iterations
+};
+
+/// \brief Outcome of the iteration.
+enum class ViewStatus {
+  Converged,     ///< t_f has no projected occlusion point within `clearance`
+  NotConverged,  ///< max_iterations reached; t_f is the best visited iterate
+  NoOccluders,   ///< no valid occluder: t_f = t0
+};
+
+/// \brief Which rule produced t0 after the spec's fallbacks (spec §2).
+enum class InitialViewUsed { SphericalMean, VectorMean, Camera };
+
+/**
+ * \brief Fully resolved estimator settings. Lengths in metres.
+ *
+ * The defaults are the `paper` preset with r_seed = 0.02 m and
+ * r_sphere = 0.5 m. To apply a preset with other radii, use
+ * EstimatorParams::resolve().
+ */
+struct EstimatorSettings {
+  double r_seed = 0.02;    ///< supervoxel seed resolution R_seed [m]
+  double r_sphere = 0.5;   ///< radius of the solution sphere R_sphere [m]
+  InitialView initial_view = InitialView::SphericalMean;
+  double clearance = 0.02;     ///< stop when no projected point is closer than this to t_i [m]
+  double push_radius = 0.5;    ///< projected points closer than this push the iterate [m]
+  PushWeighting push_weighting = PushWeighting::Sum;
+  double step = 0.02;          ///< length of one push on the tangent plane [m]
+  int max_iterations = 500;    ///< push steps before giving up (>= 0)
+  bool warm_start = false;     ///< start from the previous frame's view instead of t0
+};
+
+/**
+ * \brief Settings as a user states them: a preset plus explicit overrides.
+ *
+ * resolve() applies the preset with the final r_seed and r_sphere, then the
+ * explicit values, then validates (spec §4 `preset`, §7).
+ */
+struct EstimatorParams {
+  Preset preset = Preset::Paper;
+  std::optional<double> r_seed;
+  std::optional<double> r_sphere;
+  std::optional<InitialView> initial_view;
+  std::optional<double> clearance;
+  std::optional<double> push_radius;
+  std::optional<PushWeighting> push_weighting;
+  std::optional<double> step;
+  std::optional<int> max_iterations;
+  std::optional<bool> warm_start;
+
+  /// \brief The settings these parameters stand for.
+  /// \throws std::invalid_argument naming the parameter and value that break spec §7.
+  [[nodiscard]] EstimatorSettings resolve() const;
+};
+
+/// \brief Throws std::invalid_argument, naming the parameter and its value,
+/// unless every length is finite and positive and max_iterations >= 0.
+void validate(const EstimatorSettings& settings);
+
+/**
+ * \brief One frame's input to the estimator, in the world frame [m].
+ *
+ * Columns are points. Invalid supervoxels and occluders are skipped and
+ * counted in the estimate (spec §7); invalid optional inputs throw.
+ */
+struct ViewProblem {
+  Eigen::Matrix3Xd positions;  ///< 3 x N object supervoxel centroids v_n
+  Eigen::Matrix3Xd normals;    ///< 3 x N supervoxel normals p_n (any length > 1e-12)
+  Eigen::Matrix3Xd occluders;  ///< 3 x B occluder points q_b (may be empty)
+  std::optional<Eigen::Vector3d> centroid;       ///< C; default: mean of the valid v_n
+  std::optional<Eigen::Matrix3d> axes;           ///< columns e1, e2, e3; default: PCA of the v_n
+  std::optional<Eigen::Vector3d> camera;         ///< current camera position (t0's last fallback)
+  std::optional<Eigen::Vector3d> previous_view;  ///< previous t_f, used with warm_start
+};
+
+/// \brief Mean and population standard deviation of an angular error [deg].
+struct AngularErrorStats {
+  double mean = 0.0;
+  double std = 0.0;
+};
+
+/// \brief The estimator's result for one frame (spec §8), world frame [m].
+struct ViewEstimate {
+  Eigen::Vector3d t0 = Eigen::Vector3d::Zero();  ///< initial (occlusion-blind) view
+  Eigen::Vector3d tf = Eigen::Vector3d::Zero();  ///< final (occlusion-free) view
+  ViewStatus status = ViewStatus::NoOccluders;
+  int iterations = 0;  ///< push steps taken (0 when the start is clear)
+  InitialViewUsed initial_view_used = InitialViewUsed::SphericalMean;
+  int skipped_supervoxels = 0;  ///< non-finite, zero normal, or at/outside the sphere
+  int skipped_occluders = 0;    ///< non-finite
+  /// Angular error (eq. 9) of t0 and tf over the used rays; empty when no supervoxel is left.
+  std::optional<AngularErrorStats> error_t0;
+  std::optional<AngularErrorStats> error_tf;
+
+  // Diagnostics.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< C used
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< e1, e2, e3 used (columns)
+  bool axes_from_world = false;   ///< PCA could not determine e1: world axes stood in
+  double tf_to_t0_deg = 0.0;      ///< angle between t_f and t0 seen from C [deg]
+  int occlusion_points = 0;       ///< N_C: occlusion-to-sphere points used
+  int clearance_points = 0;       ///< projected points within `clearance` of t_f
+  std::vector<Eigen::Vector3d> path;  ///< every visited iterate, start first, when requested
+};
+
+/// \brief Options that do not change the estimate.
+struct EstimateOptions {
+  bool record_path = false;  ///< fill ViewEstimate::path
+};
+
+/**
+ * \brief Estimates the occlusion-free view for one frame (spec §1-§6).
+ *
+ * \param problem  the frame's supervoxels, occluders and optional inputs (world frame).
+ * \param settings validated with validate().
+ * \param options  diagnostics switches.
+ * \throws std::invalid_argument on usage errors: invalid settings, a
+ *         non-finite or zero-length given axis, a non-finite optional point,
+ *         mismatched positions/normals, no usable supervoxel and no centroid,
+ *         or the camera fallback reached without a usable camera.
+ */
+[[nodiscard]] ViewEstimate estimate_view(const ViewProblem& problem,
+                                         const EstimatorSettings& settings,
+                                         const EstimateOptions& options = {});
+
+/**
+ * \brief Angle between two directions [rad], robust near 0 and pi.
+ */
+[[nodiscard]] double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+/**
+ * \brief Point where the half-line origin + t dir, t > 0, leaves the sphere.
+ * \pre origin strictly inside the sphere, dir non-zero (need not be unit).
+ */
+[[nodiscard]] Eigen::Vector3d sphere_exit(const Eigen::Vector3d& centre, double radius,
+                                          const Eigen::Vector3d& origin,
+                                          const Eigen::Vector3d& dir);
+
+/// \name Enumeration words as used in scene files and on the command line.
+/// \{
+[[nodiscard]] const char* to_string(InitialView v);
+[[nodiscard]] const char* to_string(PushWeighting v);
+[[nodiscard]] const char* to_string(Preset v);
+[[nodiscard]] const char* to_string(ViewStatus v);
+[[nodiscard]] const char* to_string(InitialViewUsed v);
+/// Parse a word; std::nullopt if it is not one of the listed words.
+[[nodiscard]] std::optional<InitialView> parse_initial_view(const std::string& word);
+[[nodiscard]] std::optional<PushWeighting> parse_push_weighting(const std::string& word);
+[[nodiscard]] std::optional<Preset> parse_preset(const std::string& word);
+/// \}
+
+}  // namespace ofv

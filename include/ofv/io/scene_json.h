@@ -1,0 +1,52 @@
+/**
+ * \file scene_json.h
+ * \brief Scene and result JSON of `ofv estimate` (ESTIMATOR-SPEC.md §8).
+ *
+ * The only place where the estimator's value types meet a parser. Errors are
+ * std::invalid_argument whose message names the source, the field and the
+ * offending value, e.g. `scene.json: supervoxels[3].normal: expected an
+ * array of 3 numbers, got "up"`.
+ */
+#pragma once
+
+#include "ofv/estimator.h"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief One frame as stored in a scene file: the problem and the parameters.
+struct Scene {
+  ViewProblem problem;
+  EstimatorParams params;
+};
+
+/// \brief Parses a scene from JSON; `source` names it in error messages.
+/// \throws std::invalid_argument on unknown keys, wrong types, bad values.
+[[nodiscard]] Scene scene_from_json(const nlohmann::json& j, const std::string& source);
+
+/// \brief Reads and parses a scene file.
+/// \throws std::invalid_argument if the file cannot be read or parsed.
+[[nodiscard]] Scene read_scene(const std::string& path);
+
+/// \brief Writes a scene as JSON (only the parameters that were given).
+[[nodiscard]] nlohmann::ordered_json scene_to_json(const Scene& scene);
+
+/**
+ * \brief Sets one parameter from its textual value, as `--set name=value`.
+ * \throws std::invalid_argument naming the parameter and value when the name
+ *         is unknown or the value is not of the parameter's type.
+ */
+void set_param(EstimatorParams& params, const std::string& name, const std::string& value);
+
+/// \brief Names of the parameters accepted in `params` and by set_param().
+[[nodiscard]] const std::vector<std::string>& param_names();
+
+/// \brief The result object of spec §8, plus diagnostics (`centroid`, `axes`,
+/// `tf_to_t0_deg`, `occlusion_points`, and `path` when recorded).
+[[nodiscard]] nlohmann::ordered_json estimate_to_json(const ViewEstimate& estimate);
+
+}  // namespace ofv

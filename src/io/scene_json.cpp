@@ -1,0 +1,340 @@
+// Scene and result JSON (ESTIMATOR-SPEC.md §8).
+#include "ofv/io/scene_json.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace ofv {
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+// Error context: "<source>: <field>".
+struct Where {
+  const std::string& source;
+  std::string field;
+  [[nodiscard]] Where operator[](const std::string& key) const {
+    return {source, field.empty() ? key : field + "." + key};
+  }
+  [[nodiscard]] Where operator[](std::size_t index) const {
+    return {source, field + "[" + std::to_string(index) + "]"};
+  }
+};
+
+std::string shown(const json& j) {
+  std::string text = j.dump();
+  constexpr std::size_t kMax = 60;
+  if (text.size() > kMax) {
+    text = text.substr(0, kMax) + "...";
+  }
+  return text;
+}
+
+[[noreturn]] void fail(const Where& at, const std::string& what) {
+  throw std::invalid_argument(at.source + ": " + at.field + ": " + what);
+}
+
+[[noreturn]] void fail(const Where& at, const std::string& expected, const json& got) {
+  fail(at, "expected " + expected + ", got " + shown(got));
+}
+
+double number(const json& j, const Where& at) {
+  if (!j.is_number()) {
+    fail(at, "a number", j);
+  }
+  return j.get<double>();
+}
+
+Eigen::Vector3d vec3(const json& j, const Where& at) {
+  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() ||
+      !j[2].is_number()) {
+    fail(at, "an array of 3 numbers", j);
+  }
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+void check_keys(const json& j, const Where& at, std::initializer_list<const char*> allowed) {
+  for (const auto& item : j.items()) {
+    bool known = false;
+    for (const char* key : allowed) {
+      known = known || item.key() == key;
+    }
+    if (!known) {
+      std::string list;
+      for (const char* key : allowed) {
+        list += list.empty() ? key : std::string(", ") + key;
+      }
+      fail(at[item.key()], "unknown key (expected one of: " + list + ")");
+    }
+  }
+}
+
+double positive_param(const std::string& name, double v, const Where& at) {
+  if (!std::isfinite(v) || v <= 0.0) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    fail(at, "parameter '" + name + "' must be finite and positive, got " + s.str());
+  }
+  return v;
+}
+
+int iterations_param(const json& j, const Where& at) {
+  if (j.is_number_integer()) {
+    if (j.is_number_unsigned() ? j.get<std::uint64_t>() <= INT_MAX
+                               : (j.get<std::int64_t>() >= 0 && j.get<std::int64_t>() <= INT_MAX)) {
+      return j.get<int>();
+    }
+  }
+  fail(at, "a non-negative integer", j);
+}
+
+// One parameter from JSON; shared by the scene's `params` and `--set`.
+void set_param_json(EstimatorParams& p, const std::string& name, const json& j, const Where& at) {
+  auto word = [&](const char* listed) -> std::string {
+    if (!j.is_string()) {
+      fail(at, std::string("one of ") + listed, j);
+    }
+    return j.get<std::string>();
+  };
+  if (name == "preset") {
+    const auto v = parse_preset(word("paper, authors_code"));
+    if (!v) fail(at, "one of paper, authors_code", j);
+    p.preset = *v;
+  } else if (name == "r_seed") {
+    p.r_seed = positive_param(name, number(j, at), at);
+  } else if (name == "r_sphere") {
+    p.r_sphere = positive_param(name, number(j, at), at);
+  } else if (name == "initial_view") {
+    const auto v = parse_initial_view(word("spherical_mean, vector_mean"));
+    if (!v) fail(at, "one of spherical_mean, vector_mean", j);
+    p.initial_view = *v;
+  } else if (name == "clearance") {
+    p.clearance = positive_param(name, number(j, at), at);
+  } else if (name == "push_radius") {
+    p.push_radius = positive_param(name, number(j, at), at);
+  } else if (name == "push_weighting") {
+    const auto v = parse_push_weighting(word("sum, inverse_distance"));
+    if (!v) fail(at, "one of sum, inverse_distance", j);
+    p.push_weighting = *v;
+  } else if (name == "step") {
+    p.step = positive_param(name, number(j, at), at);
+  } else if (name == "max_iterations") {
+    p.max_iterations = iterations_param(j, at);
+  } else if (name == "warm_start") {
+    if (!j.is_boolean()) fail(at, "true or false", j);
+    p.warm_start = j.get<bool>();
+  } else {
+    std::string list;
+    for (const auto& known : param_names()) {
+      list += list.empty() ? known : ", " + known;
+    }
+    fail(at, "unknown parameter (expected one of: " + list + ")");
+  }
+}
+
+Eigen::Matrix3Xd points(const json& j, const Where& at) {
+  if (!j.is_array()) {
+    fail(at, "an array of [x, y, z] points", j);
+  }
+  Eigen::Matrix3Xd m(3, static_cast<Eigen::Index>(j.size()));
+  for (std::size_t k = 0; k < j.size(); ++k) {
+    m.col(static_cast<Eigen::Index>(k)) = vec3(j[k], at[k]);
+  }
+  return m;
+}
+
+ordered_json to_json(const Eigen::Vector3d& v) { return ordered_json::array({v.x(), v.y(), v.z()}); }
+
+ordered_json to_json(const std::optional<AngularErrorStats>& e) {
+  if (!e) {
+    return ordered_json{{"mean", nullptr}, {"std", nullptr}};
+  }
+  return ordered_json{{"mean", e->mean}, {"std", e->std}};
+}
+
+}  // namespace
+
+const std::vector<std::string>& param_names() {
+  static const std::vector<std::string> names{
+      "preset", "r_seed",         "r_sphere", "initial_view",   "clearance",
+      "push_radius", "push_weighting", "step", "max_iterations", "warm_start"};
+  return names;
+}
+
+Scene scene_from_json(const json& j, const std::string& source) {
+  const Where root{source, ""};
+  if (!j.is_object()) {
+    fail(Where{source, "scene"}, "a JSON object", j);
+  }
+  check_keys(j, root,
+             {"supervoxels", "occluders", "centroid", "axes", "camera", "previous_view", "params"});
+  Scene scene;
+  ViewProblem& pb = scene.problem;
+
+  if (!j.contains("supervoxels")) {
+    fail(root["supervoxels"], "missing (an array of {\"position\", \"normal\"} objects is required)");
+  }
+  const json& svs = j["supervoxels"];
+  const Where at_svs = root["supervoxels"];
+  if (!svs.is_array()) {
+    fail(at_svs, "an array of {\"position\", \"normal\"} objects", svs);
+  }
+  pb.positions.resize(3, static_cast<Eigen::Index>(svs.size()));
+  pb.normals.resize(3, static_cast<Eigen::Index>(svs.size()));
+  for (std::size_t k = 0; k < svs.size(); ++k) {
+    const Where at = at_svs[k];
+    const json& sv = svs[k];
+    if (!sv.is_object()) {
+      fail(at, "an object with \"position\" and \"normal\"", sv);
+    }
+    check_keys(sv, at, {"position", "normal"});
+    for (const char* key : {"position", "normal"}) {
+      if (!sv.contains(key)) {
+        fail(at[key], "missing");
+      }
+    }
+    pb.positions.col(static_cast<Eigen::Index>(k)) = vec3(sv["position"], at["position"]);
+    pb.normals.col(static_cast<Eigen::Index>(k)) = vec3(sv["normal"], at["normal"]);
+  }
+
+  pb.occluders = j.contains("occluders") ? points(j["occluders"], root["occluders"])
+                                          : Eigen::Matrix3Xd(3, 0);
+  if (j.contains("centroid")) pb.centroid = vec3(j["centroid"], root["centroid"]);
+  if (j.contains("camera")) pb.camera = vec3(j["camera"], root["camera"]);
+  if (j.contains("previous_view")) {
+    pb.previous_view = vec3(j["previous_view"], root["previous_view"]);
+  }
+  if (j.contains("axes")) {
+    const json& a = j["axes"];
+    if (!a.is_array() || a.size() != 3) {
+      fail(root["axes"], "an array of 3 axes [[e1], [e2], [e3]]", a);
+    }
+    Eigen::Matrix3d axes;
+    for (std::size_t k = 0; k < 3; ++k) {
+      axes.col(static_cast<Eigen::Index>(k)) = vec3(a[k], root["axes"][k]);
+    }
+    pb.axes = axes;
+  }
+  if (j.contains("params")) {
+    const json& params = j["params"];
+    if (!params.is_object()) {
+      fail(root["params"], "an object", params);
+    }
+    for (const auto& item : params.items()) {
+      set_param_json(scene.params, item.key(), item.value(), root["params"][item.key()]);
+    }
+  }
+  return scene;
+}
+
+Scene read_scene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::invalid_argument(path + ": cannot read file (" + std::strerror(errno) + ")");
+  }
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument(path + ": invalid JSON: " + e.what());
+  }
+  return scene_from_json(j, path);
+}
+
+void set_param(EstimatorParams& params, const std::string& name, const std::string& value) {
+  const std::string source = "--set " + name + "=" + value;
+  const Where at{source, name};
+  json j;
+  if (name == "preset" || name == "initial_view" || name == "push_weighting") {
+    j = value;
+  } else if (name == "warm_start") {
+    if (value == "true" || value == "1" || value == "on") {
+      j = true;
+    } else if (value == "false" || value == "0" || value == "off") {
+      j = false;
+    } else {
+      fail(at, "true or false, got \"" + value + "\"");
+    }
+  } else {
+    // Numbers are read with JSON's grammar, so "0.02", "2e-2" and "500" are
+    // accepted and "abc" or "0.02m" are not.
+    j = json::parse(value, nullptr, false);
+    if (j.is_discarded()) {
+      j = value;  // reported below as a string of the wrong type
+    }
+  }
+  set_param_json(params, name, j, at);
+}
+
+ordered_json scene_to_json(const Scene& scene) {
+  const ViewProblem& pb = scene.problem;
+  ordered_json j;
+  j["supervoxels"] = ordered_json::array();
+  for (Eigen::Index k = 0; k < pb.positions.cols(); ++k) {
+    j["supervoxels"].push_back(ordered_json{{"position", to_json(pb.positions.col(k))},
+                                            {"normal", to_json(pb.normals.col(k))}});
+  }
+  j["occluders"] = ordered_json::array();
+  for (Eigen::Index k = 0; k < pb.occluders.cols(); ++k) {
+    j["occluders"].push_back(to_json(pb.occluders.col(k)));
+  }
+  if (pb.centroid) j["centroid"] = to_json(*pb.centroid);
+  if (pb.axes) {
+    j["axes"] = ordered_json::array(
+        {to_json(pb.axes->col(0)), to_json(pb.axes->col(1)), to_json(pb.axes->col(2))});
+  }
+  if (pb.camera) j["camera"] = to_json(*pb.camera);
+  if (pb.previous_view) j["previous_view"] = to_json(*pb.previous_view);
+
+  const EstimatorParams& p = scene.params;
+  ordered_json params;
+  params["preset"] = to_string(p.preset);
+  if (p.r_seed) params["r_seed"] = *p.r_seed;
+  if (p.r_sphere) params["r_sphere"] = *p.r_sphere;
+  if (p.initial_view) params["initial_view"] = to_string(*p.initial_view);
+  if (p.clearance) params["clearance"] = *p.clearance;
+  if (p.push_radius) params["push_radius"] = *p.push_radius;
+  if (p.push_weighting) params["push_weighting"] = to_string(*p.push_weighting);
+  if (p.step) params["step"] = *p.step;
+  if (p.max_iterations) params["max_iterations"] = *p.max_iterations;
+  if (p.warm_start) params["warm_start"] = *p.warm_start;
+  j["params"] = params;
+  return j;
+}
+
+ordered_json estimate_to_json(const ViewEstimate& e) {
+  ordered_json j;
+  j["t0"] = to_json(e.t0);
+  j["tf"] = to_json(e.tf);
+  j["status"] = to_string(e.status);
+  j["iterations"] = e.iterations;
+  j["initial_view_used"] = to_string(e.initial_view_used);
+  j["skipped_supervoxels"] = e.skipped_supervoxels;
+  j["skipped_occluders"] = e.skipped_occluders;
+  j["angular_error_deg"] = ordered_json{{"t0", to_json(e.error_t0)}, {"tf", to_json(e.error_tf)}};
+  j["tf_to_t0_deg"] = e.tf_to_t0_deg;
+  j["centroid"] = to_json(e.centroid);
+  j["axes"] = ordered_json::array(
+      {to_json(e.axes.col(0)), to_json(e.axes.col(1)), to_json(e.axes.col(2))});
+  j["axes_from_world"] = e.axes_from_world;
+  j["occlusion_points"] = e.occlusion_points;
+  j["clearance_points"] = e.clearance_points;
+  if (!e.path.empty()) {
+    j["path"] = ordered_json::array();
+    for (const auto& t : e.path) {
+      j["path"].push_back(to_json(t));
+    }
+  }
+  return j;
+}
+
+}  // namespace ofv
