@@ -1,8 +1,7 @@
 # Warnings (and sanitizers) for ofv's own targets. Third-party headers come in
 # as SYSTEM includes, so their warnings never need hiding here.
 function(ofv_warnings target)
-  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wconversion
-                                           -Wno-sign-conversion)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow)
   if(OFV_WARNINGS_AS_ERRORS)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
