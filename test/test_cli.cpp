@@ -1,1 +1,158 @@
+// End to end through the real `ofv` binary.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("ofv_cli_" + std::string(info->name()) + "_" +
+                                        std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `ofv ARGS` with no standard input.
+  CommandResult ofv(const std::string& args) const {
+    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
+    const std::string cmd = std::string("\"") + OFV_BINARY + "\" " + args + " >\"" +
+                            out.string() + "\" 2>\"" + err.string() + "\" </dev/null";
+    const int status = std::system(cmd.c_str());
+    CommandResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+const std::string kExample = std::string(OFV_SOURCE_DIR) + "/data/scenes/dvd-case-hand.json";
+
+TEST_F(Cli, HelpExplainsEverySetting) {
+  const CommandResult top = ofv("--help");
+  EXPECT_EQ(top.exit_code, 0);
+  EXPECT_NE(top.out.find("estimate"), std::string::npos);
+  const CommandResult r = ofv("estimate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* s : {"preset", "r_seed", "r_sphere", "initial_view", "clearance", "push_radius",
+                        "push_weighting", "step", "max_iterations", "warm_start", "[m]",
+                        "default"}) {
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  }
+}
+
+TEST_F(Cli, EstimatesTheShippedExample) {
+  const CommandResult r = ofv("estimate " + kExample);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty());
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["status"], "converged");
+  EXPECT_GT(j["iterations"].get<int>(), 0);
+  // The hand is on the left (-x): the view moves right.
+  EXPECT_GT(j["tf"][0].get<double>(), j["t0"][0].get<double>());
+  EXPECT_GT(j["angular_error_deg"]["tf"]["mean"].get<double>(),
+            j["angular_error_deg"]["t0"]["mean"].get<double>());
+}
+
+TEST_F(Cli, SetOverridesTheFile) {
+  const CommandResult r = ofv("estimate " + kExample + " --set max_iterations=0 --set step=0.01 --compact");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["status"], "not_converged");
+  EXPECT_EQ(j["iterations"], 0);
+  EXPECT_EQ(j["tf"], j["t0"]);
+
+  const CommandResult path = ofv("estimate " + kExample + " --path --compact");
+  const json k = json::parse(path.out);
+  EXPECT_EQ(k["path"].size(), k["iterations"].get<std::size_t>() + 1);
+}
+
+TEST_F(Cli, ConformanceCaseThroughTheBinary) {
+  const std::string dir = std::string(OFV_TEST_DATA_DIR) + "/conformance/";
+  for (const char* name : {"edge-warm-start", "edge-authors-code-preset", "random-34"}) {
+    const CommandResult r = ofv("estimate " + dir + name + ".json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const json got = json::parse(r.out);
+    const json expected = json::parse(slurp(dir + name + ".expected.json"));
+    EXPECT_EQ(got["status"], expected["status"]) << name;
+    EXPECT_EQ(got["iterations"], expected["iterations"]) << name;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(got["tf"][k].get<double>(), expected["tf"][k].get<double>(), 1e-6) << name;
+    }
+  }
+}
+
+TEST_F(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
+  const std::string sv = R"("supervoxels": [{"position": [0, 0, 1], "normal": [0, 0, -1]}])";
+  struct Case {
+    std::string args;
+    std::vector<std::string> mentions;
+  };
+  const std::vector<Case> cases{
+      {"estimate " + (dir_ / "absent.json").string(), {"absent.json", "cannot read"}},
+      {"estimate " + write("syntax.json", "{\"supervoxels\": [").string(), {"syntax.json", "invalid JSON"}},
+      {"estimate " + write("overflow.json", "{" + sv + ", \"occluders\": [[1e999, 0, 0]]}").string(),
+       {"overflow.json", "invalid JSON"}},
+      {"estimate " + write("empty.json", "{}").string(), {"empty.json", "supervoxels", "missing"}},
+      {"estimate " + write("unknown.json", "{" + sv + ", \"colour\": 3}").string(), {"unknown.json", "colour"}},
+      {"estimate " + write("type.json", "{\"supervoxels\": [{\"position\": 1, \"normal\": [0,0,1]}]}").string(),
+       {"type.json", "supervoxels[0].position", "1"}},
+      {"estimate " + write("neg.json", "{" + sv + ", \"params\": {\"r_sphere\": -0.5}}").string(),
+       {"neg.json", "r_sphere", "-0.5"}},
+      {"estimate " + write("word.json", "{" + sv + ", \"params\": {\"push_weighting\": \"max\"}}").string(),
+       {"word.json", "push_weighting", "max"}},
+      {"estimate " + write("nosv.json", "{\"supervoxels\": []}").string(), {"nosv.json", "no usable supervoxel"}},
+      {"estimate " + write("ok1.json", "{" + sv + "}").string() + " --set speed=3", {"speed", "unknown parameter"}},
+      {"estimate " + write("ok2.json", "{" + sv + "}").string() + " --set step=-1", {"step", "-1"}},
+      {"estimate " + write("ok3.json", "{" + sv + "}").string() + " --set step", {"--set step", "name=value"}},
+      {"estimate", {"scene"}},
+      {"estimate a.json b.json", {"b.json"}},
+      {"frobnicate", {"frobnicate"}},
+  };
+  for (const auto& c : cases) {
+    const CommandResult r = ofv(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args;
+    EXPECT_TRUE(r.out.empty()) << c.args << ": " << r.out;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << ": " << r.err;
+    for (const auto& m : c.mentions) {
+      EXPECT_NE(r.err.find(m), std::string::npos) << c.args << ": " << r.err;
+    }
+  }
+}
+
+}  // namespace

@@ -2,6 +2,7 @@
 #include "commands.h"
 
 #include <iostream>
+#include <string>
 #include <vector>
 
 int main(int argc, char** argv) {
@@ -15,6 +16,16 @@ int main(int argc, char** argv) {
 
   const std::vector<Command> commands{add_estimate_command(app)};
 
+  std::string known;
+  bool listed = argc < 2 || argv[1][0] == '-';
+  for (const Command& command : commands) {
+    known += (known.empty() ? "" : ", ") + command.app->get_name();
+    listed = listed || command.app->get_name() == argv[1];
+  }
+  if (!listed) {
+    std::cerr << "ofv: unknown command '" << argv[1] << "' (commands: " << known << ")\n";
+    return kUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

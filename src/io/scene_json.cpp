@@ -244,7 +244,7 @@ Scene read_scene(const std::string& path) {
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax errors and number overflow (1e999)
     throw std::invalid_argument(path + ": invalid JSON: " + e.what());
   }
   return scene_from_json(j, path);
@@ -267,8 +267,9 @@ void set_param(EstimatorParams& params, const std::string& name, const std::stri
   } else {
     // Numbers are read with JSON's grammar, so "0.02", "2e-2" and "500" are
     // accepted and "abc" or "0.02m" are not.
-    j = json::parse(value, nullptr, false);
-    if (j.is_discarded()) {
+    try {
+      j = json::parse(value);
+    } catch (const json::exception&) {
       j = value;  // reported below as a string of the wrong type
     }
   }
