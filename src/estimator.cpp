@@ -85,7 +85,7 @@ Axes object_axes(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
     const Eigen::Matrix3Xd centred = points.colwise() - mean;
     const Eigen::Matrix3d cov = centred * centred.transpose() / static_cast<double>(n);
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    const Eigen::Vector3d lambda = eig.eigenvalues();  // ascending
+    const Eigen::Vector3d& lambda = eig.eigenvalues();  // ascending
     if (lambda(2) - lambda(1) > kPcaEps * lambda(2)) {
       const Eigen::Vector3d e1 = eig.eigenvectors().col(2).normalized();
       const Eigen::Vector3d e2 = eig.eigenvectors().col(1).normalized();
