@@ -438,8 +438,23 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
     Eigen::Vector3d best = start;
     int best_count = std::numeric_limits<int>::max();
     double best_angle = std::numeric_limits<double>::infinity();
+    // The iteration is a deterministic map of t alone: once an iterate repeats
+    // bit for bit, every later one is a repeat too, none clear and none better.
+    // Brent's cycle detection finds that in O(1) memory, so that a huge
+    // max_iterations on a cycling scene ends with the result it would reach.
+    Eigen::Vector3d checkpoint = start;
+    long steps_since_checkpoint = 0;
+    long checkpoint_period = 1;
+    bool cycling = false;
     for (int i = 0;; ++i) {
       const Eigen::Vector3d t_from_c = t - c;
+      if (cycling) {
+        est.status = ViewStatus::NotConverged;
+        est.tf = best;
+        est.iterations = settings.max_iterations;
+        est.clearance_points = best_count;
+        break;
+      }
       if (options.record_path) est.path.push_back(t);
       const Projection proj = project(occ, t_from_c, r, settings);
       if (proj.in_clearance == 0) {
@@ -474,6 +489,12 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
       }
       const Eigen::Vector3d t_pi = t + settings.step * push.normalized();
       t = c + r * (t_pi - c).normalized();
+      cycling = t == checkpoint;
+      if (++steps_since_checkpoint == checkpoint_period) {
+        checkpoint = t;
+        checkpoint_period *= 2;
+        steps_since_checkpoint = 0;
+      }
     }
   }
 

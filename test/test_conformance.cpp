@@ -109,3 +109,22 @@ TEST(ConformanceData, AllCasesArePresent) { EXPECT_GE(case_names().size(), 49U);
 
 }  // namespace
 }  // namespace ofv
+
+namespace ofv {
+namespace {
+
+TEST(Iteration, ExactCycleEndsEarlyWithTheSameResult) {
+  // random-34 never converges: its iterates fall into an exact cycle.
+  const Scene scene = read_scene(std::string(OFV_TEST_DATA_DIR) + "/conformance/random-34.json");
+  EstimatorSettings s = scene.params.resolve();
+  const ViewEstimate at_500 = estimate_view(scene.problem, s);
+  s.max_iterations = 2'000'000'000;  // would take hours without cycle detection
+  const ViewEstimate huge = estimate_view(scene.problem, s, {true});
+  EXPECT_EQ(huge.status, ViewStatus::NotConverged);
+  EXPECT_EQ(huge.iterations, s.max_iterations);
+  EXPECT_EQ(huge.tf, at_500.tf);
+  EXPECT_LT(huge.path.size(), 1000U);
+}
+
+}  // namespace
+}  // namespace ofv

@@ -16,6 +16,9 @@ struct Command {
   std::function<int()> run;
 };
 
+/// The estimator settings, their defaults and units, for every command's help.
+const char* estimator_settings_help();
+
 /// Registers `ofv estimate` on the app.
 Command add_estimate_command(CLI::App& app);
 

@@ -16,7 +16,7 @@ namespace ofv::cli {
 
 namespace {
 
-constexpr const char* kSettingsHelp = R"(Scene file (metres, world frame):
+constexpr const char* kSceneHelp = R"(Scene file (metres, world frame):
   {"supervoxels": [{"position": [x,y,z], "normal": [x,y,z]}, ...],   required
    "occluders": [[x,y,z], ...],      points q_b (default none)
    "centroid": [x,y,z],              object centroid C (default: mean of positions)
@@ -25,7 +25,12 @@ constexpr const char* kSettingsHelp = R"(Scene file (metres, world frame):
    "previous_view": [x,y,z],         previous t_f, used with warm_start
    "params": {name: value, ...}}     any setting below
 
-Settings (in "params" or with --set name=value; explicit values override the preset):
+)";
+
+}  // namespace
+
+const char* estimator_settings_help() {
+  return R"(Estimator settings (in "params" or with --set name=value; explicit values override the preset):
   preset          paper | authors_code              default paper
                   authors_code: step = r_seed/2, clearance = 2 r_seed, max_iterations = 50
   r_seed          supervoxel seed resolution [m]    default 0.02
@@ -40,7 +45,12 @@ Settings (in "params" or with --set name=value; explicit values override the pre
   step            length of one push on the tangent plane [m]  default r_seed
   max_iterations  push steps before giving up (integer >= 0)   default 500
   warm_start      true | false: start from previous_view instead of t0  default false
+)";
+}
 
+namespace {
+
+constexpr const char* kOutputHelp = R"(
 Output: one JSON object (t0, tf, status, iterations, initial_view_used, skipped counts,
 angular_error_deg) on stdout. Exit 0 ok, 2 bad input (one line on stderr).)";
 
@@ -61,7 +71,7 @@ Command add_estimate_command(CLI::App& app) {
       ->type_name("NAME=VALUE");
   sub->add_flag("--path", opt->path, "Also output every visited iterate ('path')");
   sub->add_flag("--compact", opt->compact, "Print the JSON on one line");
-  sub->footer(kSettingsHelp);
+  sub->footer(std::string(kSceneHelp) + estimator_settings_help() + kOutputHelp);
 
   return {sub, [opt]() -> int {
             try {

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_help_all_flag("--help-all", "Print the help of every command");
 
   const std::vector<Command> commands{add_estimate_command(app)};
+  app.footer(estimator_settings_help());
 
   std::string known;
   bool listed = argc < 2 || argv[1][0] == '-';

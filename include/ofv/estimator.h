@@ -142,7 +142,10 @@ struct ViewEstimate {
   double tf_to_t0_deg = 0.0;      ///< angle between t_f and t0 seen from C [deg]
   int occlusion_points = 0;       ///< N_C: occlusion-to-sphere points used
   int clearance_points = 0;       ///< projected points within `clearance` of t_f
-  std::vector<Eigen::Vector3d> path;  ///< every visited iterate, start first, when requested
+  /// Every visited iterate, start first, when requested. When the iteration
+  /// falls into an exact cycle, the path stops where the cycle closes (the
+  /// rest would only repeat it) while `iterations` reports max_iterations.
+  std::vector<Eigen::Vector3d> path;
 };
 
 /// \brief Options that do not change the estimate.
