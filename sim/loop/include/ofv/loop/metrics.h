@@ -1,0 +1,89 @@
+/**
+ * \file metrics.h
+ * \brief Per-step records of a closed-loop episode and the episode summary
+ *        (`metrics.json` of `ofv simulate`, one row of `ofv compare`).
+ *
+ * Pure bookkeeping on std and Eigen: the runner fills a StepRecord per frame
+ * from the simulator's ground truth and the pipeline's outputs.
+ */
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief Wall-clock time spent in each stage of one closed-loop step [s].
+struct StageTimes {
+  double render = 0.0;
+  double perception = 0.0;
+  double estimate = 0.0;
+  double control = 0.0;
+  [[nodiscard]] double total() const { return render + perception + estimate + control; }
+};
+
+/// \brief What happened in one frame period of an episode.
+struct StepRecord {
+  double time = 0.0;                                       ///< simulated time [s]
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();   ///< camera pose at the frame
+  Eigen::Matrix<double, 6, 1> velocity = Eigen::Matrix<double, 6, 1>::Zero();  ///< commanded (v, w), camera frame [m/s, rad/s]
+  std::optional<Eigen::Vector3d> t0;  ///< estimator's initial view (none when no estimate)
+  std::optional<Eigen::Vector3d> tf;  ///< estimator's final view
+  std::string status;                 ///< estimator status, or "object_lost", "static" ...
+  int iterations = 0;                 ///< estimator push steps
+  double visible_fraction = 0.0;      ///< true fraction of the object surface seen [0, 1]
+  double angular_error_deg = 0.0;     ///< eq. 9 of the real camera vs the true normals [deg]
+  double sphere_distance_error = 0.0; ///< |camera - true centroid| - r_sphere [m]
+  int occluders_in_sphere = 0;        ///< ground truth: occluders inside the sphere
+  StageTimes times;                   ///< compute time of this step
+};
+
+/// \brief One occlusion event: an occluder entered the sphere.
+struct OcclusionEvent {
+  double onset = 0.0;                   ///< time the occluder count rose [s]
+  std::optional<double> recovery_time;  ///< time to visibility >= threshold again [s]; none if never
+};
+
+/// \brief Summary of an episode.
+struct EpisodeMetrics {
+  int steps = 0;
+  double duration = 0.0;                ///< simulated [s]
+  double mean_visible_fraction = 0.0;
+  double min_visible_fraction = 0.0;
+  double time_below_threshold = 0.0;    ///< simulated time with visibility < threshold [s]
+  double visibility_threshold = 0.9;
+  std::vector<OcclusionEvent> occlusions;
+  std::optional<double> max_recovery_time;   ///< worst recovery over events; none if one never recovered
+  int unrecovered_occlusions = 0;
+  double mean_angular_error_deg = 0.0;
+  double path_length = 0.0;             ///< camera path [m]
+  double max_sphere_distance_error = 0.0;  ///< max |distance to centroid - r_sphere| [m]
+  double max_linear_speed = 0.0;        ///< [m/s]
+  double max_angular_speed = 0.0;       ///< [rad/s]
+  StageTimes mean_times;                ///< mean compute time per stage [s]
+  StageTimes max_times;                 ///< worst step per stage [s]
+  int estimator_iterations_max = 0;
+  std::vector<std::pair<std::string, int>> status_counts;  ///< steps per status
+};
+
+/**
+ * \brief Summarises an episode.
+ * \param steps  records in time order, one per frame period.
+ * \param threshold  visibility counted as "in view" [0, 1].
+ * Each step stands for the interval until the next one (the last for the
+ * mean period). Recovery is measured from the onset to the first step at or
+ * after it whose visibility is >= threshold (0 when it never dropped).
+ */
+[[nodiscard]] EpisodeMetrics summarise(const std::vector<StepRecord>& steps,
+                                       double threshold = 0.9);
+
+/// \brief Header line of trajectory.csv.
+[[nodiscard]] std::string trajectory_csv_header();
+/// \brief One row of trajectory.csv (same columns as the header).
+[[nodiscard]] std::string trajectory_csv_row(const StepRecord& step);
+
+}  // namespace ofv

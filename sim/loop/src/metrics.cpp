@@ -1,0 +1,135 @@
+// Episode summary and trajectory rows.
+#include "ofv/loop/metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace ofv {
+
+namespace {
+
+// How long each step stands for: until the next step; the last one for the
+// mean period (or 0 for a single step).
+std::vector<double> step_durations(const std::vector<StepRecord>& steps) {
+  std::vector<double> dt(steps.size(), 0.0);
+  for (std::size_t k = 0; k + 1 < steps.size(); ++k) {
+    dt[k] = steps[k + 1].time - steps[k].time;
+  }
+  if (steps.size() >= 2) {
+    dt.back() = (steps.back().time - steps.front().time) / static_cast<double>(steps.size() - 1);
+  }
+  return dt;
+}
+
+}  // namespace
+
+EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold) {
+  EpisodeMetrics m;
+  m.visibility_threshold = threshold;
+  m.steps = static_cast<int>(steps.size());
+  if (steps.empty()) {
+    return m;
+  }
+  const std::vector<double> dt = step_durations(steps);
+  double total = 0.0;
+  double visible = 0.0;
+  double error = 0.0;
+  m.min_visible_fraction = steps.front().visible_fraction;
+  std::map<std::string, int> statuses;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const StepRecord& s = steps[k];
+    total += dt[k];
+    visible += s.visible_fraction * dt[k];
+    error += s.angular_error_deg * dt[k];
+    m.min_visible_fraction = std::min(m.min_visible_fraction, s.visible_fraction);
+    if (s.visible_fraction < threshold) m.time_below_threshold += dt[k];
+    if (k > 0) m.path_length += (s.wMc.translation() - steps[k - 1].wMc.translation()).norm();
+    m.max_sphere_distance_error = std::max(m.max_sphere_distance_error, std::abs(s.sphere_distance_error));
+    m.max_linear_speed = std::max(m.max_linear_speed, s.velocity.head<3>().norm());
+    m.max_angular_speed = std::max(m.max_angular_speed, s.velocity.tail<3>().norm());
+    m.mean_times.render += s.times.render;
+    m.mean_times.perception += s.times.perception;
+    m.mean_times.estimate += s.times.estimate;
+    m.mean_times.control += s.times.control;
+    m.max_times.render = std::max(m.max_times.render, s.times.render);
+    m.max_times.perception = std::max(m.max_times.perception, s.times.perception);
+    m.max_times.estimate = std::max(m.max_times.estimate, s.times.estimate);
+    m.max_times.control = std::max(m.max_times.control, s.times.control);
+    m.estimator_iterations_max = std::max(m.estimator_iterations_max, s.iterations);
+    ++statuses[s.status];
+  }
+  m.duration = total;
+  // Time-weighted means; a single step (no duration) weighs as one sample.
+  const double w = total > 0.0 ? total : 1.0;
+  if (total > 0.0) {
+    m.mean_visible_fraction = visible / w;
+    m.mean_angular_error_deg = error / w;
+  } else {
+    m.mean_visible_fraction = steps.front().visible_fraction;
+    m.mean_angular_error_deg = steps.front().angular_error_deg;
+  }
+  const auto n = static_cast<double>(steps.size());
+  m.mean_times.render /= n;
+  m.mean_times.perception /= n;
+  m.mean_times.estimate /= n;
+  m.mean_times.control /= n;
+  m.status_counts.assign(statuses.begin(), statuses.end());
+
+  // Occlusion events: the ground-truth count of occluders in the sphere rises.
+  for (std::size_t k = 1; k < steps.size(); ++k) {
+    if (steps[k].occluders_in_sphere <= steps[k - 1].occluders_in_sphere) continue;
+    OcclusionEvent e;
+    e.onset = steps[k].time;
+    for (std::size_t j = k; j < steps.size(); ++j) {
+      if (steps[j].visible_fraction >= threshold) {
+        e.recovery_time = steps[j].time - e.onset;
+        break;
+      }
+    }
+    m.occlusions.push_back(e);
+  }
+  double worst = 0.0;
+  for (const auto& e : m.occlusions) {
+    if (e.recovery_time) {
+      worst = std::max(worst, *e.recovery_time);
+    } else {
+      ++m.unrecovered_occlusions;
+    }
+  }
+  if (m.unrecovered_occlusions == 0) m.max_recovery_time = worst;
+  return m;
+}
+
+std::string trajectory_csv_header() {
+  return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,status,iterations,"
+         "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,"
+         "render_s,perception_s,estimate_s,control_s";
+}
+
+std::string trajectory_csv_row(const StepRecord& s) {
+  std::ostringstream out;
+  out.precision(9);
+  const Eigen::Quaterniond q(s.wMc.rotation());
+  const Eigen::Vector3d p = s.wMc.translation();
+  auto vec = [&](const std::optional<Eigen::Vector3d>& v) {
+    if (v) {
+      out << v->x() << ',' << v->y() << ',' << v->z() << ',';
+    } else {
+      out << ",,,";
+    }
+  };
+  out << s.time << ',' << p.x() << ',' << p.y() << ',' << p.z() << ',' << q.x() << ',' << q.y()
+      << ',' << q.z() << ',' << q.w() << ',';
+  for (int k = 0; k < 6; ++k) out << s.velocity(k) << ',';
+  vec(s.t0);
+  vec(s.tf);
+  out << s.status << ',' << s.iterations << ',' << s.visible_fraction << ','
+      << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
+      << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
+      << s.times.control;
+  return out.str();
+}
+
+}  // namespace ofv

@@ -1,0 +1,74 @@
+// Episode metrics on hand-made step sequences.
+#include "ofv/loop/metrics.h"
+
+#include <gtest/gtest.h>
+
+namespace ofv {
+namespace {
+
+// Steps at 10 Hz with the given visibilities and occluder counts.
+std::vector<StepRecord> episode(const std::vector<double>& visible, const std::vector<int>& occluders) {
+  std::vector<StepRecord> steps(visible.size());
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    steps[k].time = 0.1 * static_cast<double>(k);
+    steps[k].visible_fraction = visible[k];
+    steps[k].occluders_in_sphere = occluders[k];
+    steps[k].wMc.translation() = Eigen::Vector3d(0.01 * static_cast<double>(k), 0, 0);
+    steps[k].status = k % 2 ? "converged" : "no_occluders";
+  }
+  return steps;
+}
+
+TEST(Metrics, VisibilityRecoveryAndPath) {
+  const auto steps = episode({1.0, 1.0, 0.5, 0.6, 0.95, 1.0}, {0, 0, 1, 1, 1, 1});
+  const EpisodeMetrics m = summarise(steps);
+  EXPECT_EQ(m.steps, 6);
+  EXPECT_NEAR(m.duration, 0.6, 1e-12);
+  EXPECT_NEAR(m.mean_visible_fraction, (1 + 1 + 0.5 + 0.6 + 0.95 + 1) / 6, 1e-12);
+  EXPECT_EQ(m.min_visible_fraction, 0.5);
+  EXPECT_NEAR(m.time_below_threshold, 0.2, 1e-12);
+  ASSERT_EQ(m.occlusions.size(), 1U);
+  EXPECT_NEAR(m.occlusions[0].onset, 0.2, 1e-12);
+  ASSERT_TRUE(m.occlusions[0].recovery_time);
+  EXPECT_NEAR(*m.occlusions[0].recovery_time, 0.2, 1e-12);
+  EXPECT_NEAR(*m.max_recovery_time, 0.2, 1e-12);
+  EXPECT_NEAR(m.path_length, 0.05, 1e-12);
+  ASSERT_EQ(m.status_counts.size(), 2U);
+  EXPECT_EQ(m.status_counts[0].first, "converged");
+  EXPECT_EQ(m.status_counts[0].second, 3);
+}
+
+TEST(Metrics, AnOcclusionThatNeverClearsIsUnrecovered) {
+  const auto steps = episode({1.0, 0.2, 0.3, 0.4}, {0, 2, 2, 2});
+  const EpisodeMetrics m = summarise(steps);
+  ASSERT_EQ(m.occlusions.size(), 1U);
+  EXPECT_FALSE(m.occlusions[0].recovery_time);
+  EXPECT_EQ(m.unrecovered_occlusions, 1);
+  EXPECT_FALSE(m.max_recovery_time);
+}
+
+TEST(Metrics, AnOccluderThatDoesNotHideRecoversAtOnce) {
+  const auto steps = episode({1.0, 1.0, 1.0}, {0, 1, 0});
+  const EpisodeMetrics m = summarise(steps);
+  ASSERT_EQ(m.occlusions.size(), 1U);
+  EXPECT_EQ(*m.occlusions[0].recovery_time, 0.0);
+  EXPECT_EQ(m.time_below_threshold, 0.0);
+}
+
+TEST(Metrics, EmptyAndSingleStepEpisodes) {
+  EXPECT_EQ(summarise({}).steps, 0);
+  const EpisodeMetrics one = summarise(episode({0.7}, {0}));
+  EXPECT_EQ(one.mean_visible_fraction, 0.7);
+  EXPECT_EQ(one.duration, 0.0);
+}
+
+TEST(Metrics, TrajectoryRowMatchesTheHeader) {
+  StepRecord s;
+  s.tf = Eigen::Vector3d(1, 2, 3);
+  s.status = "converged";
+  const auto count = [](const std::string& line) { return std::count(line.begin(), line.end(), ','); };
+  EXPECT_EQ(count(trajectory_csv_row(s)), count(trajectory_csv_header()));
+}
+
+}  // namespace
+}  // namespace ofv
