@@ -1,0 +1,72 @@
+/**
+ * \file baselines.h
+ * \brief What ofv's estimator is compared against in closed loop.
+ *
+ * - a static camera (never moves);
+ * - the occlusion-blind initial view t0 (the authors' previous method);
+ * - a sampling next-best-view planner: candidate views spread evenly on the
+ *   sphere (a Fibonacci lattice), each scored by ray casting the object's
+ *   supervoxels against the occluders and by normal alignment; the best one
+ *   is taken. This is what a user of NBV planners would try instead.
+ *
+ * Pure geometry on Eigen, on the estimator's own ViewProblem, so that every
+ * method sees exactly the same input.
+ */
+#pragma once
+
+#include "ofv/estimator.h"
+
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief The view-selection methods of the closed-loop harness.
+enum class ViewMethod {
+  Estimator,  ///< ofv's occlusion-free view (t_f)
+  Static,     ///< keep the camera where it is
+  InitialView,  ///< occlusion-blind t0
+  Sampling,   ///< best of many candidate views on the sphere
+};
+
+[[nodiscard]] const char* to_string(ViewMethod m);
+/// \throws std::invalid_argument listing the valid words.
+[[nodiscard]] ViewMethod parse_view_method(const std::string& word);
+
+/// \brief `n` unit directions spread evenly on the sphere (Fibonacci lattice).
+[[nodiscard]] Eigen::Matrix3Xd fibonacci_directions(int n);
+
+/// \brief Settings of the sampling planner.
+struct SamplingSettings {
+  int candidates = 2000;         ///< candidate views on the sphere
+  double occluder_radius = 0.015;  ///< an occluder point blocks rays passing closer than this [m]
+};
+
+/// \brief A scored view.
+struct ScoredView {
+  Eigen::Vector3d view = Eigen::Vector3d::Zero();  ///< camera position on the sphere (world) [m]
+  double visible_fraction = 0.0;  ///< supervoxels whose line of sight misses every occluder [0, 1]
+  double mean_error_deg = 0.0;    ///< mean angular error (eq. 9) over the supervoxels [deg]
+};
+
+/**
+ * \brief Scores a camera position: the fraction of the usable supervoxels
+ *        (spec §1, §7) it sees past the occluders, each occluder a ball of
+ *        radius `occluder_radius`, and its mean angular error (eq. 9).
+ *        Supervoxels facing away (normal . (view - v) <= 0) count as unseen.
+ * \param centroid C of the problem (ViewEstimate::centroid) [m].
+ * \param r_sphere radius of the sphere [m].
+ */
+[[nodiscard]] ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
+                                    double r_sphere, const Eigen::Vector3d& view,
+                                    double occluder_radius);
+
+/**
+ * \brief The sampling next-best-view planner: the candidate with the largest
+ *        visible fraction, ties broken by the smallest mean angular error.
+ */
+[[nodiscard]] ScoredView sample_best_view(const ViewProblem& problem,
+                                          const Eigen::Vector3d& centroid, double r_sphere,
+                                          const SamplingSettings& sampling);
+
+}  // namespace ofv

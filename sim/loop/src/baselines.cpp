@@ -1,0 +1,141 @@
+// Baselines of the closed-loop comparison.
+#include "ofv/loop/baselines.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace ofv {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+// The supervoxels the estimator would use (spec §1, §7), with their rays s_n - C.
+struct UsedSupervoxels {
+  Eigen::Matrix3Xd v, normal, ray;
+};
+
+UsedSupervoxels used_supervoxels(const ViewProblem& p, const Eigen::Vector3d& c, double r) {
+  UsedSupervoxels u;
+  const Eigen::Index n = p.positions.cols();
+  u.v.resize(3, n);
+  u.normal.resize(3, n);
+  u.ray.resize(3, n);
+  Eigen::Index k = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d v = p.positions.col(i);
+    const Eigen::Vector3d nv = p.normals.col(i);
+    if (!v.allFinite() || !nv.allFinite() || !(nv.norm() >= 1e-12) || !((v - c).norm() < r)) {
+      continue;
+    }
+    u.v.col(k) = v;
+    u.normal.col(k) = nv.normalized();
+    u.ray.col(k) = sphere_exit(c, r, v, nv) - c;
+    ++k;
+  }
+  u.v.conservativeResize(3, k);
+  u.normal.conservativeResize(3, k);
+  u.ray.conservativeResize(3, k);
+  return u;
+}
+
+Eigen::Matrix3Xd finite_occluders(const ViewProblem& p) {
+  Eigen::Matrix3Xd q(3, p.occluders.cols());
+  Eigen::Index k = 0;
+  for (Eigen::Index b = 0; b < p.occluders.cols(); ++b) {
+    if (p.occluders.col(b).allFinite()) q.col(k++) = p.occluders.col(b);
+  }
+  q.conservativeResize(3, k);
+  return q;
+}
+
+ScoredView score(const UsedSupervoxels& u, const Eigen::Matrix3Xd& q, const Eigen::Vector3d& c,
+                 const Eigen::Vector3d& view, double rho) {
+  ScoredView s;
+  s.view = view;
+  const Eigen::Index n = u.v.cols();
+  if (n == 0) return s;
+  const double rho2 = rho * rho;
+  int seen = 0;
+  double error = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    error += angle_between(u.ray.col(i), view - c);
+    const Eigen::Vector3d seg = view - u.v.col(i);
+    if (u.normal.col(i).dot(seg) <= 0.0) continue;
+    const double len2 = seg.squaredNorm();
+    bool blocked = false;
+    for (Eigen::Index b = 0; b < q.cols() && !blocked; ++b) {
+      const Eigen::Vector3d rel = q.col(b) - u.v.col(i);
+      const double t = std::clamp(rel.dot(seg) / len2, 0.0, 1.0);
+      blocked = (rel - t * seg).squaredNorm() < rho2;
+    }
+    seen += blocked ? 0 : 1;
+  }
+  s.visible_fraction = static_cast<double>(seen) / static_cast<double>(n);
+  s.mean_error_deg = error / static_cast<double>(n) * kRadToDeg;
+  return s;
+}
+
+}  // namespace
+
+const char* to_string(ViewMethod m) {
+  switch (m) {
+    case ViewMethod::Estimator: return "estimator";
+    case ViewMethod::Static: return "static";
+    case ViewMethod::InitialView: return "initial_view";
+    case ViewMethod::Sampling: return "sampling";
+  }
+  return "?";
+}
+
+ViewMethod parse_view_method(const std::string& word) {
+  for (auto m : {ViewMethod::Estimator, ViewMethod::Static, ViewMethod::InitialView,
+                 ViewMethod::Sampling}) {
+    if (word == to_string(m)) return m;
+  }
+  throw std::invalid_argument("unknown view method \"" + word +
+                              "\" (expected one of: estimator, static, initial_view, sampling)");
+}
+
+Eigen::Matrix3Xd fibonacci_directions(int n) {
+  if (n < 1) throw std::invalid_argument("candidate count must be >= 1, got " + std::to_string(n));
+  Eigen::Matrix3Xd d(3, n);
+  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < n; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / n;
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = golden * k;
+    d.col(k) << rho * std::cos(phi), rho * std::sin(phi), z;
+  }
+  return d;
+}
+
+ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
+                      const Eigen::Vector3d& view, double occluder_radius) {
+  return score(used_supervoxels(problem, centroid, r_sphere), finite_occluders(problem), centroid,
+               view, occluder_radius);
+}
+
+ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
+                            double r_sphere, const SamplingSettings& sampling) {
+  if (!(sampling.occluder_radius > 0.0) || !std::isfinite(sampling.occluder_radius)) {
+    throw std::invalid_argument("sampling occluder_radius must be finite and positive");
+  }
+  const UsedSupervoxels u = used_supervoxels(problem, centroid, r_sphere);
+  const Eigen::Matrix3Xd q = finite_occluders(problem);
+  const Eigen::Matrix3Xd dirs = fibonacci_directions(sampling.candidates);
+  ScoredView best;
+  best.visible_fraction = -1.0;
+  for (Eigen::Index k = 0; k < dirs.cols(); ++k) {
+    const ScoredView s =
+        score(u, q, centroid, centroid + r_sphere * dirs.col(k), sampling.occluder_radius);
+    if (s.visible_fraction > best.visible_fraction ||
+        (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
+      best = s;
+    }
+  }
+  return best;
+}
+
+}  // namespace ofv

@@ -1,0 +1,78 @@
+// Baselines: Fibonacci candidates, view scoring and the sampling planner.
+#include "ofv/loop/baselines.h"
+
+#include <gtest/gtest.h>
+
+namespace ofv {
+namespace {
+
+// A 5 x 4 patch at z = 0.5 facing a camera at the origin, one hand-sized
+// occluder cluster right on the initial ray.
+ViewProblem occluded_patch() {
+  ViewProblem p;
+  p.positions.resize(3, 20);
+  p.normals.resize(3, 20);
+  for (int k = 0; k < 20; ++k) {
+    p.positions.col(k) << (k % 5 - 2) * 0.03, (k / 5 - 1.5) * 0.03, 0.5;
+    p.normals.col(k) << 0, 0, -1;
+  }
+  p.occluders.resize(3, 9);
+  for (int k = 0; k < 9; ++k) p.occluders.col(k) << (k % 3 - 1) * 0.01, (k / 3 - 1) * 0.01, 0.25;
+  return p;
+}
+
+TEST(Baselines, FibonacciDirectionsCoverTheSphereEvenly) {
+  const Eigen::Matrix3Xd d = fibonacci_directions(500);
+  ASSERT_EQ(d.cols(), 500);
+  EXPECT_LT((d.colwise().norm().array() - 1.0).abs().maxCoeff(), 1e-12);
+  EXPECT_LT(d.rowwise().mean().norm(), 0.01);
+  double nearest_max = 0.0;
+  for (Eigen::Index i = 0; i < d.cols(); ++i) {
+    double nearest = 10.0;
+    for (Eigen::Index j = 0; j < d.cols(); ++j) {
+      if (i != j) nearest = std::min(nearest, (d.col(i) - d.col(j)).norm());
+    }
+    nearest_max = std::max(nearest_max, nearest);
+  }
+  EXPECT_LT(nearest_max, 2.5 * std::sqrt(4.0 * 3.14159 / 500));  // no hole
+  EXPECT_THROW((void)fibonacci_directions(0), std::invalid_argument);
+}
+
+TEST(Baselines, OccluderOnTheInitialRay) {
+  const ViewProblem p = occluded_patch();
+  const EstimatorSettings s;
+  const ViewEstimate e = estimate_view(p, s);
+  const double rho = 0.015;
+  const ScoredView at_t0 = score_view(p, e.centroid, s.r_sphere, e.t0, rho);
+  const ScoredView at_tf = score_view(p, e.centroid, s.r_sphere, e.tf, rho);
+  SamplingSettings sampling;
+  sampling.candidates = 1500;
+  sampling.occluder_radius = rho;
+  const ScoredView sampled = sample_best_view(p, e.centroid, s.r_sphere, sampling);
+  EXPECT_LT(at_t0.visible_fraction, 0.5);  // the blind view loses the object
+  EXPECT_EQ(at_tf.visible_fraction, 1.0);  // ours keeps it
+  EXPECT_EQ(sampled.visible_fraction, 1.0);
+  EXPECT_NEAR((sampled.view - e.centroid).norm(), s.r_sphere, 1e-12);
+  // Both moved off the ray, by a similar, small angle.
+  EXPECT_GT(at_tf.mean_error_deg, at_t0.mean_error_deg);
+  EXPECT_LT(sampled.mean_error_deg, 45.0);
+}
+
+TEST(Baselines, FacingAwaySupervoxelsAreUnseen) {
+  ViewProblem p = occluded_patch();
+  p.occluders.resize(3, 0);
+  const Eigen::Vector3d c(0, 0, 0.5);
+  EXPECT_EQ(score_view(p, c, 0.5, Eigen::Vector3d(0, 0, 0), 0.015).visible_fraction, 1.0);
+  EXPECT_EQ(score_view(p, c, 0.5, Eigen::Vector3d(0, 0, 1), 0.015).visible_fraction, 0.0);
+}
+
+TEST(Baselines, MethodWords) {
+  for (auto m : {ViewMethod::Estimator, ViewMethod::Static, ViewMethod::InitialView,
+                 ViewMethod::Sampling}) {
+    EXPECT_EQ(parse_view_method(to_string(m)), m);
+  }
+  EXPECT_THROW((void)parse_view_method("nbv"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ofv
