@@ -1,0 +1,88 @@
+// EpisodeMetrics <-> JSON.
+#include "ofv/loop/metrics_json.h"
+
+namespace ofv {
+
+namespace {
+
+using nlohmann::json;
+
+json times_to_json(const StageTimes& t) {
+  return {{"render_s", t.render},   {"perception_s", t.perception}, {"estimate_s", t.estimate},
+          {"control_s", t.control}, {"total_s", t.total()}};
+}
+
+StageTimes times_from_json(const json& j) {
+  StageTimes t;
+  t.render = j.at("render_s").get<double>();
+  t.perception = j.at("perception_s").get<double>();
+  t.estimate = j.at("estimate_s").get<double>();
+  t.control = j.at("control_s").get<double>();
+  return t;
+}
+
+template <class T>
+json optional_json(const std::optional<T>& v) {
+  return v ? json(*v) : json(nullptr);
+}
+
+}  // namespace
+
+json metrics_to_json(const EpisodeMetrics& m) {
+  json occlusions = json::array();
+  for (const auto& e : m.occlusions) {
+    occlusions.push_back({{"onset_s", e.onset}, {"recovery_time_s", optional_json(e.recovery_time)}});
+  }
+  json statuses = json::object();
+  for (const auto& [status, count] : m.status_counts) statuses[status] = count;
+  return {{"steps", m.steps},
+          {"duration_s", m.duration},
+          {"visibility_threshold", m.visibility_threshold},
+          {"mean_visible_fraction", m.mean_visible_fraction},
+          {"min_visible_fraction", m.min_visible_fraction},
+          {"time_below_threshold_s", m.time_below_threshold},
+          {"occlusions", occlusions},
+          {"max_recovery_time_s", optional_json(m.max_recovery_time)},
+          {"unrecovered_occlusions", m.unrecovered_occlusions},
+          {"mean_angular_error_deg", m.mean_angular_error_deg},
+          {"path_length_m", m.path_length},
+          {"max_sphere_distance_error_m", m.max_sphere_distance_error},
+          {"max_linear_speed_mps", m.max_linear_speed},
+          {"max_angular_speed_radps", m.max_angular_speed},
+          {"mean_compute_time", times_to_json(m.mean_times)},
+          {"max_compute_time", times_to_json(m.max_times)},
+          {"estimator_iterations_max", m.estimator_iterations_max},
+          {"status_counts", statuses}};
+}
+
+EpisodeMetrics metrics_from_json(const json& j) {
+  EpisodeMetrics m;
+  m.steps = j.at("steps").get<int>();
+  m.duration = j.at("duration_s").get<double>();
+  m.visibility_threshold = j.at("visibility_threshold").get<double>();
+  m.mean_visible_fraction = j.at("mean_visible_fraction").get<double>();
+  m.min_visible_fraction = j.at("min_visible_fraction").get<double>();
+  m.time_below_threshold = j.at("time_below_threshold_s").get<double>();
+  for (const auto& e : j.at("occlusions")) {
+    OcclusionEvent ev;
+    ev.onset = e.at("onset_s").get<double>();
+    if (!e.at("recovery_time_s").is_null()) ev.recovery_time = e.at("recovery_time_s").get<double>();
+    m.occlusions.push_back(ev);
+  }
+  if (!j.at("max_recovery_time_s").is_null()) m.max_recovery_time = j.at("max_recovery_time_s").get<double>();
+  m.unrecovered_occlusions = j.at("unrecovered_occlusions").get<int>();
+  m.mean_angular_error_deg = j.at("mean_angular_error_deg").get<double>();
+  m.path_length = j.at("path_length_m").get<double>();
+  m.max_sphere_distance_error = j.at("max_sphere_distance_error_m").get<double>();
+  m.max_linear_speed = j.at("max_linear_speed_mps").get<double>();
+  m.max_angular_speed = j.at("max_angular_speed_radps").get<double>();
+  m.mean_times = times_from_json(j.at("mean_compute_time"));
+  m.max_times = times_from_json(j.at("max_compute_time"));
+  m.estimator_iterations_max = j.at("estimator_iterations_max").get<int>();
+  for (const auto& [status, count] : j.at("status_counts").items()) {
+    m.status_counts.emplace_back(status, count.get<int>());
+  }
+  return m;
+}
+
+}  // namespace ofv
