@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 namespace ofv {
@@ -77,16 +76,6 @@ void check_keys(const json& j, const Where& at, std::initializer_list<const char
   }
 }
 
-double positive_param(const std::string& name, double v, const Where& at) {
-  if (!std::isfinite(v) || v <= 0.0) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    fail(at, "parameter '" + name + "' must be finite and positive, got " + s.str());
-  }
-  return v;
-}
-
 int iterations_param(const json& j, const Where& at) {
   if (j.is_number_integer()) {
     if (j.is_number_unsigned() ? j.get<std::uint64_t>() <= INT_MAX
@@ -110,23 +99,23 @@ void set_param_json(EstimatorParams& p, const std::string& name, const json& j, 
     if (!v) fail(at, "one of paper, authors_code", j);
     p.preset = *v;
   } else if (name == "r_seed") {
-    p.r_seed = positive_param(name, number(j, at), at);
+    p.r_seed = number(j, at);  // range checked by EstimatorParams::resolve()
   } else if (name == "r_sphere") {
-    p.r_sphere = positive_param(name, number(j, at), at);
+    p.r_sphere = number(j, at);
   } else if (name == "initial_view") {
     const auto v = parse_initial_view(word("spherical_mean, vector_mean"));
     if (!v) fail(at, "one of spherical_mean, vector_mean", j);
     p.initial_view = *v;
   } else if (name == "clearance") {
-    p.clearance = positive_param(name, number(j, at), at);
+    p.clearance = number(j, at);
   } else if (name == "push_radius") {
-    p.push_radius = positive_param(name, number(j, at), at);
+    p.push_radius = number(j, at);
   } else if (name == "push_weighting") {
     const auto v = parse_push_weighting(word("sum, inverse_distance"));
     if (!v) fail(at, "one of sum, inverse_distance", j);
     p.push_weighting = *v;
   } else if (name == "step") {
-    p.step = positive_param(name, number(j, at), at);
+    p.step = number(j, at);
   } else if (name == "max_iterations") {
     p.max_iterations = iterations_param(j, at);
   } else if (name == "warm_start") {
