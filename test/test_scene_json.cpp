@@ -167,5 +167,16 @@ TEST(SceneJson, ResultHasEverySpecField) {
   EXPECT_TRUE(k["angular_error_deg"]["tf"]["std"].is_null());
 }
 
+TEST(SceneJson, PrettyPrintingKeepsTheValue) {
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(
+      R"({"a": [1, 2.5, -3e-7], "b": {"c": null, "d": [[1, 2, 3], [4, 5, 6]]},
+          "path": [[0, 0, 1], [0, 1, 0], [1, 0, 0], [1, 1, 1]], "e": [], "f": {}, "s": "x,y"})");
+  const std::string text = to_pretty_string(j);
+  EXPECT_EQ(nlohmann::ordered_json::parse(text), j);
+  EXPECT_NE(text.find("\"a\": [1, 2.5, -3e-07]"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"s\": \"x,y\""), std::string::npos) << text;  // strings untouched
+  EXPECT_NE(text.find("    [1, 1, 1]"), std::string::npos) << text;  // long lists one per line
+}
+
 }  // namespace
 }  // namespace ofv

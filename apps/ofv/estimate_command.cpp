@@ -92,7 +92,8 @@ Command add_estimate_command(CLI::App& app) {
               } catch (const std::invalid_argument& e) {
                 throw std::invalid_argument(opt->scene + ": " + e.what());
               }
-              std::cout << estimate_to_json(estimate).dump(opt->compact ? -1 : 2) << '\n';
+              const auto json = estimate_to_json(estimate);
+              std::cout << (opt->compact ? json.dump() : to_pretty_string(json)) << '\n';
               return kOk;
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv estimate: " << e.what() << '\n';

@@ -327,4 +327,55 @@ ordered_json estimate_to_json(const ViewEstimate& e) {
   return j;
 }
 
+namespace {
+
+// An array of numbers, or of at most three arrays of numbers (axes).
+bool is_flat(const ordered_json& j, bool nested = false) {
+  if (!j.is_array()) return false;
+  for (const auto& item : j) {
+    const bool ok = item.is_number() || item.is_null() ||
+                    (!nested && j.size() <= 3 && is_flat(item, true));
+    if (!ok) return false;
+  }
+  return true;
+}
+
+void write_pretty(std::string& out, const ordered_json& j, int depth) {
+  const std::string pad(static_cast<std::size_t>(2 * depth), ' ');
+  if (j.is_object() && !j.empty()) {
+    out += "{\n";
+    std::size_t k = 0;
+    for (const auto& item : j.items()) {
+      out += pad + "  " + ordered_json(item.key()).dump() + ": ";
+      write_pretty(out, item.value(), depth + 1);
+      out += ++k < j.size() ? ",\n" : "\n";
+    }
+    out += pad + "}";
+  } else if (j.is_array() && !j.empty() && !is_flat(j)) {
+    out += "[\n";
+    for (std::size_t k = 0; k < j.size(); ++k) {
+      out += pad + "  ";
+      write_pretty(out, j[k], depth + 1);
+      out += k + 1 < j.size() ? ",\n" : "\n";
+    }
+    out += pad + "]";
+  } else {
+    std::string flat = j.dump();
+    if (j.is_array()) {  // one space after each comma, as people write it
+      std::string spaced;
+      for (char ch : flat) spaced += ch == ',' ? std::string(", ") : std::string(1, ch);
+      flat = spaced;
+    }
+    out += flat;
+  }
+}
+
+}  // namespace
+
+std::string to_pretty_string(const ordered_json& j) {
+  std::string out;
+  write_pretty(out, j, 0);
+  return out;
+}
+
 }  // namespace ofv

@@ -49,4 +49,8 @@ void set_param(EstimatorParams& params, const std::string& name, const std::stri
 /// `tf_to_t0_deg`, `occlusion_points`, and `path` when recorded).
 [[nodiscard]] nlohmann::ordered_json estimate_to_json(const ViewEstimate& estimate);
 
+/// \brief JSON for people: objects indented by two spaces, arrays whose items
+/// are all numbers (or all short arrays of numbers) kept on one line.
+[[nodiscard]] std::string to_pretty_string(const nlohmann::ordered_json& j);
+
 }  // namespace ofv
