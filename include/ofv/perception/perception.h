@@ -1,0 +1,224 @@
+/**
+ * \file perception.h
+ * \brief The perception front end of Cuiral-Zueco and López-Nicolás,
+ *        "Dynamic Occlusion Handling for Real Time Object Perception",
+ *        section II: supervoxels, the tracked object, its augmented OBB,
+ *        interacting and occluding elements, and the estimator's ViewProblem.
+ *
+ * All positions are in the world frame W [m]. One Perception object follows
+ * one object through a sequence of frames:
+ *
+ * \code
+ * ofv::Perception perception(ofv::PerceptionSettings{});   // default start: see ObjectSelection
+ * while (auto frame = source.next()) {
+ *   const ofv::PerceptionResult r = perception.process(*frame);
+ *   if (r.status == ofv::TrackingStatus::Lost) continue;
+ *   const ofv::ViewEstimate e = ofv::estimate_view(r.problem, ofv::EstimatorSettings{});
+ * }
+ * \endcode
+ *
+ * Assumptions (paper, section II-C): frame 0 sees the whole object; the
+ * object and the other elements move little between consecutive frames.
+ */
+#pragma once
+
+#include "ofv/estimator.h"
+#include "ofv/perception/cloud.h"
+#include "ofv/rgbd_frame.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace ofv {
+
+/// \brief Settings of the supervoxel stage (pcl::SupervoxelClustering).
+struct SupervoxelSettings {
+  double voxel_resolution = 0.008;  ///< voxel edge [m]
+  double seed_resolution = 0.02;    ///< R_seed: spacing of supervoxel seeds [m] (paper: 0.02)
+  double colour_importance = 0.2;   ///< weight of colour distance in the clustering
+  double spatial_importance = 0.4;  ///< weight of spatial distance
+  double normal_importance = 1.0;   ///< weight of normal difference
+  /// alpha of paper eq. 1: two supervoxels are adjacent when their centroids
+  /// lie within R_adj = alpha R_seed. The paper bounds it to [1, 1.5].
+  double adjacency_alpha = 1.5;
+};
+
+/// \brief Settings of the object tracker.
+struct TrackingSettings {
+  /// Largest motion of an object surface point between consecutive frames
+  /// [m] (paper assumption 2). A voxel of the new frame is near the object
+  /// when it lies within this distance of the previous object's voxel cloud.
+  double max_motion = 0.012;
+  /// A supervoxel joins the object when at least this fraction of its voxels
+  /// is near the previous object. Supervoxels respect colour and normal
+  /// boundaries, so a hand touching the object forms its own supervoxels and
+  /// stays out even though a few of its voxels touch the object.
+  double min_near_fraction = 0.5;
+  /// A voxel counts as near the object only if the object voxel it is near
+  /// has a chromaticity similar to its own (R, G, B over their sum, so shading does not
+  /// matter): Euclidean distance at most this. Keeps the table under the
+  /// object and a touching hand of another colour out; <= 0 turns it off.
+  double max_chroma_distance = 0.06;
+  /// The object is lost when fewer of its voxels than this fraction of the
+  /// previous frame's are found (the last known state is kept for re-acquisition).
+  double min_kept_fraction = 0.2;
+  /// Object voxels hidden behind something nearer the camera are remembered
+  /// for this many frames, so the occluded part is recognised when it
+  /// reappears [frames].
+  int occlusion_memory_frames = 60;
+  /// Dominant plane (RANSAC on the first frame, at least a fifth of its
+  /// points) inlier distance [m]. Supervoxels on that plane (centroid within
+  /// this distance, normal within 60 degrees) are never object: the table
+  /// the object rests on. Nor are voxels on the plane of the plane's colour
+  /// (its mean chromaticity, within max_chroma_distance).
+  double plane_distance = 0.01;
+  /// Smallest cluster accepted by the default start [supervoxels].
+  int min_cluster_supervoxels = 3;
+};
+
+/// \brief How the object is picked in the first frame.
+struct ObjectSelection {
+  enum class Mode {
+    /// After removing the dominant plane (RANSAC), the cluster of adjacent
+    /// supervoxels nearest the image centre.
+    Auto,
+    Box,    ///< supervoxels whose centroid is inside `box` (world frame)
+    Image,  ///< supervoxels whose centroid projects inside `rect` or onto a non-zero `mask` pixel
+  };
+  Mode mode = Mode::Auto;
+  Eigen::AlignedBox3d box;        ///< world frame [m], for Mode::Box (also the first crop)
+  Eigen::AlignedBox2i rect;       ///< pixels [u0, v0] .. [u1, v1] inclusive, for Mode::Image
+  std::vector<std::uint8_t> mask; ///< width x height, non-zero = object; overrides `rect`
+};
+
+/// \brief All settings of the front end.
+struct PerceptionSettings {
+  CloudSettings cloud;             ///< back-projection; its voxel resolution is supervoxels.voxel_resolution
+  SupervoxelSettings supervoxels;
+  TrackingSettings tracking;
+  double r_sphere = 0.5;           ///< R_sphere = d_pref (paper eq. 2) [m]
+  double crop_margin = 0.1;        ///< crop radius = r_sphere + crop_margin around the previous C [m]
+  double max_depth = 3.0;          ///< points farther along the optical axis are dropped [m]
+  /// The object's OBB (PCA of its voxels) grows by this on every side [m]:
+  /// what lies inside it but is not object is interacting (a holding hand).
+  double obb_margin = 0.03;
+  ObjectSelection selection;
+};
+
+/// \brief Whether the object was found in a frame.
+enum class TrackingStatus {
+  Initialised,  ///< first frame: the object was selected
+  Tracking,     ///< followed from the previous frame
+  Lost,         ///< not found (too few voxels near its last state, or no valid selection)
+};
+
+/// \brief The class of a supervoxel (paper section II-B).
+enum class SupervoxelClass { Object, Interacting, Occluder, Background };
+
+/// \brief One supervoxel of a frame (world frame).
+struct SupervoxelInfo {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< v_n [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< unit, towards the camera that saw it
+  Eigen::Vector3f colour = Eigen::Vector3f::Zero();    ///< mean R, G, B in [0, 255]
+  int voxel_count = 0;
+  bool normal_valid = true;  ///< false when PCL gave no finite normal (not used as object vertex)
+  SupervoxelClass label = SupervoxelClass::Background;
+};
+
+/// \brief An oriented box: centre, axes (columns, right-handed) and half extents [m].
+struct OrientedBox {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
+  /// True when world point p is inside (boundary included).
+  [[nodiscard]] bool contains(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d local = axes.transpose() * (p - centre);
+    return (local.cwiseAbs().array() <= half_extents.array()).all();
+  }
+};
+
+/// \brief Counts of one frame.
+struct PerceptionCounts {
+  std::size_t valid_pixels = 0;    ///< pixels with depth (after the stride)
+  std::size_t cropped_points = 0;  ///< inside the working volume
+  std::size_t voxels = 0;          ///< occupied voxels given to the supervoxel stage
+  std::size_t supervoxels = 0;
+  std::size_t adjacency_edges = 0; ///< pairs within R_adj
+  std::size_t object = 0;
+  std::size_t interacting = 0;
+  std::size_t occluders = 0;
+  std::size_t object_voxels = 0;
+};
+
+/// \brief Wall time of each stage [ms].
+struct PerceptionTimings {
+  double cloud = 0.0;        ///< back-projection, crop, voxelisation
+  double supervoxels = 0.0;  ///< pcl::SupervoxelClustering
+  double adjacency = 0.0;    ///< R_adj graph
+  double tracking = 0.0;     ///< selection or frame-to-frame tracking
+  double classify = 0.0;     ///< PCA, OBB, interacting/occluders, ViewProblem
+  double total = 0.0;
+};
+
+/// \brief Everything the front end found in one frame (world frame [m]).
+struct PerceptionResult {
+  TrackingStatus status = TrackingStatus::Lost;
+  /// The estimator's input: object supervoxels and normals, occluders,
+  /// centroid C, PCA axes, camera position. Empty when status is Lost.
+  ViewProblem problem;
+  std::vector<SupervoxelInfo> supervoxels;             ///< every supervoxel, labelled
+  std::vector<std::pair<int, int>> adjacency;          ///< edges (i < j) within R_adj
+  std::vector<Eigen::Vector3f> voxels;                 ///< every clustered voxel
+  std::vector<int> voxel_owner;                        ///< its supervoxel index
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< C: mean of the object voxels
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< e1, e2, e3 (columns), PCA of the object voxels
+  OrientedBox obb;                                     ///< the augmented OBB
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< pose of the camera that saw the frame
+  PerceptionCounts counts;
+  PerceptionTimings timings;
+  std::string message;  ///< why the object is lost, when it is
+};
+
+[[nodiscard]] const char* to_string(TrackingStatus status);
+[[nodiscard]] const char* to_string(SupervoxelClass label);
+
+/// \brief Throws std::invalid_argument naming the setting and value when a
+/// setting is out of range (non-positive resolutions, alpha outside [1, 1.5], ...).
+void validate(const PerceptionSettings& settings);
+
+/**
+ * \brief Follows one object through a sequence of RGB-D frames.
+ *
+ * Not thread-safe; one instance per sequence. Buffers are reused between frames.
+ */
+class Perception {
+ public:
+  /// \throws std::invalid_argument for invalid settings (see validate()).
+  explicit Perception(const PerceptionSettings& settings);
+  ~Perception();
+  Perception(Perception&&) noexcept;
+  Perception& operator=(Perception&&) noexcept;
+  Perception(const Perception&) = delete;
+  Perception& operator=(const Perception&) = delete;
+
+  /// \brief Processes the next frame.
+  /// \throws std::invalid_argument if the frame's buffers disagree with its intrinsics.
+  [[nodiscard]] PerceptionResult process(const RgbdFrame& frame);
+
+  /// \brief Forgets the object: the next frame starts again from the selection.
+  void reset();
+
+  [[nodiscard]] const PerceptionSettings& settings() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ofv

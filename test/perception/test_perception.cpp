@@ -1,0 +1,334 @@
+// The front end on analytically ray-cast frames (ofv/perception/perception.h).
+#include "ofv/perception/perception.h"
+
+#include "evaluation.h"
+#include "synthetic_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace ofv {
+namespace {
+
+using test::kHand;
+using test::kObject;
+using test::kTable;
+
+const Eigen::Vector3d kCaseCentre(0.0, 0.0, 0.0675);
+// Centre of the case's front face (the camera sees mostly that face).
+const Eigen::Vector3d kFrontFace(0.0, -0.0075, 0.0675);
+const Eigen::Vector3d kSkin(225, 170, 140);
+
+struct Frame {
+  RgbdFrame frame;
+  std::vector<int> labels;
+};
+
+Frame render(const test::SyntheticScene& scene, const Eigen::Isometry3d& wMc, int width = 640) {
+  Frame f;
+  f.frame = scene.render(test::vga(width), wMc, &f.labels);
+  return f;
+}
+
+/// The hand holding the case by its right edge: a capsule touching the side face.
+test::Shape holding_hand(double gap = 0.0) {
+  return test::make_capsule({0.115 + gap, -0.005, 0.03}, {0.115 + gap, -0.005, 0.12}, 0.02, kSkin,
+                            kHand);
+}
+
+/// A forearm 0.2 m in front of the case, across the line of sight.
+test::Shape arm_in_front() {
+  return test::make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025, kSkin, kHand);
+}
+
+TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
+  Perception perception{PerceptionSettings{}};
+  const Frame f = render(test::table_and_case(), test::front_camera());
+  const PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+  const auto score = test::score_object(r, truth, kObject);
+  EXPECT_GE(score.precision, 0.95) << score.true_positives << "/" << score.predicted;
+  EXPECT_GE(score.recall, 0.90) << score.true_positives << "/" << score.actual;
+  EXPECT_LE((r.centroid - kFrontFace).norm(), 0.01) << r.centroid.transpose();
+  // The table is not object; inside the sphere and outside the OBB it is an occluder.
+  EXPECT_EQ(test::count_truth_as(r, truth, kTable, SupervoxelClass::Object), 0);
+  EXPECT_GT(r.counts.occluders, 0u);
+  // PCA: e1 along the case's long side (world x), e3 its thin side (world y).
+  EXPECT_GT(std::abs(r.axes.col(0).dot(Eigen::Vector3d::UnitX())), 0.95);
+  EXPECT_GT(std::abs(r.axes.col(2).dot(Eigen::Vector3d::UnitY())), 0.95);
+  EXPECT_NEAR(r.axes.determinant(), 1.0, 1e-9);
+  // The augmented OBB holds every object voxel.
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == SupervoxelClass::Object) {
+      ASSERT_TRUE(r.obb.contains(r.voxels[i].cast<double>()));
+    }
+  }
+}
+
+TEST(Perception, NormalsFaceTheCameraAndAdjacencyRespectsRadius) {
+  PerceptionSettings settings;
+  Perception perception{settings};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  const Frame f = render(test::table_and_case(), wMc);
+  const PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  int facing_front = 0;
+  for (const SupervoxelInfo& s : r.supervoxels) {
+    ASSERT_NEAR(s.normal.norm(), 1.0, 1e-9);
+    ASSERT_GE(s.normal.dot(wMc.translation() - s.centroid), 0.0);
+    if (s.label == SupervoxelClass::Object && s.normal.dot(-Eigen::Vector3d::UnitY()) > 0.9) {
+      ++facing_front;
+    }
+  }
+  EXPECT_GE(facing_front, static_cast<int>(r.counts.object) / 2);
+  // Problem: one column per object supervoxel with a normal, occluders inside the sphere.
+  EXPECT_EQ(r.problem.positions.cols(), r.problem.normals.cols());
+  EXPECT_GE(r.problem.positions.cols(), 10);
+  EXPECT_EQ(r.problem.occluders.cols(), static_cast<Eigen::Index>(r.counts.occluders));
+  for (Eigen::Index j = 0; j < r.problem.occluders.cols(); ++j) {
+    ASSERT_LT((r.problem.occluders.col(j) - r.centroid).norm(), settings.r_sphere);
+  }
+  const double r_adj = settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution;
+  ASSERT_FALSE(r.adjacency.empty());
+  for (const auto& [a, b] : r.adjacency) {
+    ASSERT_LT(a, b);
+    ASSERT_LE((r.supervoxels[static_cast<std::size_t>(a)].centroid -
+               r.supervoxels[static_cast<std::size_t>(b)].centroid)
+                  .norm(),
+              r_adj + 1e-6);
+  }
+}
+
+TEST(Perception, HandHoldingTheCaseIsInteractingNotObject) {
+  Perception perception{PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  ASSERT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
+            TrackingStatus::Initialised);
+  // The hand comes in from the right, 1 cm per frame, and grips the edge.
+  PerceptionResult r;
+  Frame f;
+  for (int step = 5; step >= 0; --step) {
+    test::SyntheticScene scene = test::table_and_case();
+    scene.shapes.push_back(holding_hand(0.01 * step));
+    f = render(scene, wMc);
+    r = perception.process(f.frame);
+    ASSERT_EQ(r.status, TrackingStatus::Tracking) << "step " << step << ": " << r.message;
+  }
+  const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+  EXPECT_EQ(test::count_truth_as(r, truth, kHand, SupervoxelClass::Object), 0);
+  EXPECT_GE(test::count_truth_as(r, truth, kHand, SupervoxelClass::Interacting), 1);
+  const auto score = test::score_object(r, truth, kObject);
+  EXPECT_GE(score.precision, 0.95);
+  EXPECT_GE(score.recall, 0.90);
+  EXPECT_LE((r.centroid - test::truth_centroid(r, f.frame, f.labels, kObject)).norm(), 0.01);
+}
+
+TEST(Perception, ArmInFrontIsAnOccluderAndMovesTheView) {
+  Perception perception{PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  const PerceptionResult clear = perception.process(render(test::table_and_case(), wMc).frame);
+  ASSERT_EQ(clear.status, TrackingStatus::Initialised);
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(arm_in_front());
+  const Frame f = render(scene, wMc);
+  const PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, TrackingStatus::Tracking) << r.message;
+  const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+  const int arm_occluders = test::count_truth_as(r, truth, kHand, SupervoxelClass::Occluder);
+  EXPECT_GE(arm_occluders, 3);
+  EXPECT_EQ(test::count_truth_as(r, truth, kHand, SupervoxelClass::Object), 0);
+  // The arm hides part of the case: fewer object supervoxels than in the clear frame.
+  EXPECT_LT(r.counts.object, clear.counts.object);
+  const ViewEstimate e = estimate_view(r.problem, EstimatorSettings{});
+  EXPECT_NE(e.status, ViewStatus::NoOccluders);
+  EXPECT_EQ(e.skipped_supervoxels, 0);
+}
+
+TEST(Perception, FollowsAMovingDeformingObject) {
+  Perception perception{PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  for (int k = 0; k <= 12; ++k) {
+    // Slides 6 mm per frame to the right and stretches 1 % per frame.
+    test::SyntheticScene scene;
+    const Eigen::Vector3d centre = kCaseCentre + Eigen::Vector3d(0.006 * k, 0.0, 0.0);
+    scene.shapes.push_back(test::make_box({0.0, 0.0, -0.02}, {1.6, 1.6, 0.04}, {150, 110, 70}, kTable));
+    const double stretch = 1.0 + 0.01 * k;
+    scene.shapes.push_back(test::make_box(centre, {0.19 * stretch, 0.015, 0.135}, {40, 60, 200}, kObject));
+    scene.shapes.push_back(holding_hand(0.0));
+    scene.shapes.back().a += Eigen::Vector3d(0.006 * k + 0.095 * (stretch - 1.0), 0.0, 0.0);
+    scene.shapes.back().b += Eigen::Vector3d(0.006 * k + 0.095 * (stretch - 1.0), 0.0, 0.0);
+    if (k == 0) {
+      scene.shapes.pop_back();  // frame 0 sees the whole object
+    }
+    const Frame f = render(scene, wMc);
+    const PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k << ": " << r.message;
+    const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+    const auto score = test::score_object(r, truth, kObject);
+    EXPECT_GE(score.precision, 0.95) << "frame " << k;
+    EXPECT_GE(score.recall, 0.90) << "frame " << k;
+    EXPECT_LE((r.centroid - test::truth_centroid(r, f.frame, f.labels, kObject)).norm(), 0.01)
+        << "frame " << k;
+  }
+}
+
+TEST(Perception, MovingCameraKeepsTheObjectFixedInTheWorld) {
+  Perception perception{PerceptionSettings{}};
+  const test::SyntheticScene scene = test::table_and_case();
+  for (int k = 0; k <= 10; ++k) {
+    const double a = 0.05 * k;  // orbit 2.9 degrees per frame
+    const Eigen::Vector3d eye =
+        kCaseCentre + Eigen::Vector3d(0.45 * std::sin(a), -0.45 * std::cos(a), 0.22);
+    const Frame f = render(scene, test::look_at(eye, kCaseCentre), 320);
+    const PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k << ": " << r.message;
+    const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
+    EXPECT_GE(score.precision, 0.95) << "frame " << k;
+    EXPECT_GE(score.recall, 0.90) << "frame " << k;
+    EXPECT_LE((r.centroid - kCaseCentre).norm(), 0.015) << "frame " << k;
+  }
+}
+
+TEST(Perception, ReportsALostObjectAndFindsItAgain) {
+  Perception perception{PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  ASSERT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
+            TrackingStatus::Initialised);
+  test::SyntheticScene empty = test::table_and_case();
+  empty.shapes.pop_back();
+  const PerceptionResult gone = perception.process(render(empty, wMc).frame);
+  EXPECT_EQ(gone.status, TrackingStatus::Lost);
+  EXPECT_FALSE(gone.message.empty());
+  EXPECT_EQ(gone.problem.positions.cols(), 0);
+  const PerceptionResult back = perception.process(render(test::table_and_case(), wMc).frame);
+  EXPECT_EQ(back.status, TrackingStatus::Tracking) << back.message;
+  EXPECT_LE((back.centroid - kFrontFace).norm(), 0.01);
+}
+
+TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
+  Perception perception{PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  ASSERT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
+            TrackingStatus::Initialised);
+  // A board hides the left half of the case for a few frames, then leaves.
+  test::SyntheticScene hidden = test::table_and_case();
+  hidden.shapes.push_back(
+      test::make_box({-0.08, -0.2, 0.07}, {0.12, 0.01, 0.3}, {230, 230, 230}, test::kOther));
+  for (int k = 0; k < 3; ++k) {
+    const PerceptionResult r = perception.process(render(hidden, wMc).frame);
+    ASSERT_EQ(r.status, TrackingStatus::Tracking) << r.message;
+  }
+  const Frame f = render(test::table_and_case(), wMc);
+  const PerceptionResult r = perception.process(f.frame);
+  const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
+  EXPECT_GE(score.recall, 0.90);
+  EXPECT_GE(score.precision, 0.95);
+}
+
+TEST(Perception, BoxAndImageSelectionsPickTheCase) {
+  const Eigen::Isometry3d wMc = test::front_camera();
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(test::make_box({0.3, 0.1, 0.05}, {0.1, 0.1, 0.1}, {200, 30, 30}, test::kOther));
+  const Frame f = render(scene, wMc);
+
+  PerceptionSettings by_box;
+  by_box.selection.mode = ObjectSelection::Mode::Box;
+  by_box.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.12, -0.03, 0.005),
+                                             Eigen::Vector3d(0.12, 0.03, 0.16));
+  PerceptionSettings by_rect;
+  by_rect.selection.mode = ObjectSelection::Mode::Image;
+  // The case's front face, projected: pixels of the ground truth's bounding box.
+  Eigen::AlignedBox2i rect;
+  for (int v = 0; v < f.frame.intrinsics.height; ++v) {
+    for (int u = 0; u < f.frame.intrinsics.width; ++u) {
+      if (f.labels[f.frame.index(u, v)] == kObject) {
+        rect.extend(Eigen::Vector2i(u, v));
+      }
+    }
+  }
+  by_rect.selection.rect = rect;
+  PerceptionSettings by_mask;
+  by_mask.selection.mode = ObjectSelection::Mode::Image;
+  by_mask.selection.mask.resize(f.labels.size());
+  std::transform(f.labels.begin(), f.labels.end(), by_mask.selection.mask.begin(),
+                 [](int l) { return l == kObject ? 1 : 0; });
+
+  for (const PerceptionSettings& s : {by_box, by_rect, by_mask}) {
+    Perception perception{s};
+    const PerceptionResult r = perception.process(f.frame);
+    ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+    const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
+    EXPECT_GE(score.precision, 0.95);
+    EXPECT_GE(score.recall, 0.90);
+  }
+
+  PerceptionSettings nowhere = by_box;
+  nowhere.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(3, 3, 3));
+  Perception lost{nowhere};
+  const PerceptionResult r = lost.process(f.frame);
+  EXPECT_EQ(r.status, TrackingStatus::Lost);
+  EXPECT_NE(r.message.find("box"), std::string::npos);
+}
+
+TEST(Perception, ResultMovesWithARigidMotionOfTheWholeWorld) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, -0.4, 1.0).normalized()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(1.5, -0.7, 0.4);
+  test::SyntheticScene scene = test::table_and_case();
+  test::SyntheticScene moved = scene;
+  for (test::Shape& s : moved.shapes) {
+    s.pose = T * s.pose;
+  }
+  const Eigen::Isometry3d wMc = test::front_camera();
+  Perception a{PerceptionSettings{}};
+  Perception b{PerceptionSettings{}};
+  const PerceptionResult ra = a.process(render(scene, wMc, 320).frame);
+  const PerceptionResult rb = b.process(render(moved, T * wMc, 320).frame);
+  ASSERT_EQ(ra.status, TrackingStatus::Initialised);
+  ASSERT_EQ(rb.status, TrackingStatus::Initialised);
+  // Voxel grids are axis-aligned, so agreement is up to about a voxel.
+  EXPECT_LE((T * ra.centroid - rb.centroid).norm(), 0.005);
+  EXPECT_GT(std::abs((T.linear() * ra.axes.col(0)).dot(rb.axes.col(0))), 0.98);
+  const ViewEstimate ea = estimate_view(ra.problem, EstimatorSettings{});
+  const ViewEstimate eb = estimate_view(rb.problem, EstimatorSettings{});
+  EXPECT_LE((T * ea.t0 - eb.t0).norm(), 0.05);
+}
+
+TEST(Perception, RejectsInvalidSettings) {
+  const auto throws = [](auto mutate) {
+    PerceptionSettings s;
+    mutate(s);
+    EXPECT_THROW(Perception{s}, std::invalid_argument);
+  };
+  throws([](PerceptionSettings& s) { s.supervoxels.adjacency_alpha = 2.0; });
+  throws([](PerceptionSettings& s) { s.supervoxels.voxel_resolution = 0.0; });
+  throws([](PerceptionSettings& s) { s.supervoxels.seed_resolution = 0.001; });
+  throws([](PerceptionSettings& s) { s.r_sphere = -1.0; });
+  throws([](PerceptionSettings& s) { s.tracking.min_near_fraction = 0.0; });
+  throws([](PerceptionSettings& s) { s.selection.mode = ObjectSelection::Mode::Box; });
+  throws([](PerceptionSettings& s) { s.selection.mode = ObjectSelection::Mode::Image; });
+  try {
+    PerceptionSettings s;
+    s.supervoxels.adjacency_alpha = 2.0;
+    Perception p{s};
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("adjacency_alpha"), std::string::npos);
+  }
+}
+
+TEST(Perception, EmptyFrameIsLostNotACrash) {
+  Perception perception{PerceptionSettings{}};
+  RgbdFrame f;
+  f.intrinsics = test::vga(320);
+  f.depth.assign(320 * 240, 0.0f);
+  const PerceptionResult r = perception.process(f);
+  EXPECT_EQ(r.status, TrackingStatus::Lost);
+  EXPECT_EQ(r.counts.supervoxels, 0u);
+}
+
+}  // namespace
+}  // namespace ofv
