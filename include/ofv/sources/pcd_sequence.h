@@ -1,0 +1,58 @@
+/**
+ * \file pcd_sequence.h
+ * \brief RGB-D sequences stored as organised PCD files with a pose file.
+ *
+ * A directory holding `*.pcd` files, read in lexicographic order, each an
+ * organised `pcl::PointXYZRGBA` cloud in the camera frame (ViSP axes: X
+ * right, Y down, Z forward; metres; NaN where depth is missing), and
+ * `poses.txt`: one TUM pose line `t tx ty tz qx qy qz qw` (wMc) per PCD
+ * file, in the same order. Optional `intrinsics.txt` (`width height fx fy cx
+ * cy`); without it the intrinsics are fitted to the organised points.
+ */
+#pragma once
+
+#include "ofv/frame_source.h"
+#include "ofv/sources/sequence_files.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief Reads a PCD sequence frame by frame (see the file comment for the layout).
+class PcdSequenceSource : public FrameSource {
+ public:
+  /// \throws std::runtime_error naming the path when the directory, its PCD
+  /// files or poses.txt are missing, or the counts differ.
+  explicit PcdSequenceSource(const std::string& directory);
+
+  /// \throws std::runtime_error naming the file when a PCD cannot be read, is not
+  /// organised, or its intrinsics cannot be fitted.
+  std::optional<RgbdFrame> next() override;
+  [[nodiscard]] std::string describe() const override;
+  [[nodiscard]] std::size_t size() const { return files_.size(); }
+
+ private:
+  std::string directory_;
+  std::vector<std::string> files_;
+  std::vector<StampedPose> poses_;
+  std::optional<CameraIntrinsics> intrinsics_;
+  std::size_t next_ = 0;
+};
+
+/// \brief Writes frames as a PCD sequence (binary PCD, poses.txt, intrinsics.txt).
+class PcdSequenceWriter {
+ public:
+  /// \throws std::runtime_error naming the directory when it cannot be created.
+  explicit PcdSequenceWriter(const std::string& directory);
+  /// \throws std::invalid_argument for inconsistent buffers; std::runtime_error when a file cannot be written.
+  void write(const RgbdFrame& frame);
+  [[nodiscard]] std::size_t count() const { return count_; }
+
+ private:
+  std::string directory_;
+  std::size_t count_ = 0;
+};
+
+}  // namespace ofv

@@ -1,0 +1,50 @@
+/**
+ * \file sequence_files.h
+ * \brief Text files shared by the recorded-sequence formats: poses in the
+ *        TUM RGB-D layout and camera intrinsics.
+ */
+#pragma once
+
+#include "ofv/rgbd_frame.h"
+
+#include <Eigen/Geometry>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief A timestamped camera pose wMc (camera -> world), ViSP camera axes.
+struct StampedPose {
+  double time = 0.0;  ///< [s]
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+};
+
+/**
+ * \brief Reads a TUM pose file: `t tx ty tz qx qy qz qw` per line, `#` comments.
+ * \throws std::runtime_error naming the file and line when it cannot be read or parsed.
+ */
+[[nodiscard]] std::vector<StampedPose> read_pose_file(const std::string& path);
+
+/// \brief Appends one pose line to a TUM pose file stream's text.
+[[nodiscard]] std::string format_pose_line(double time, const Eigen::Isometry3d& wMc);
+
+/**
+ * \brief The pose at `time`: linear/slerp interpolation between the two
+ *        bracketing poses, the nearest end pose outside their range.
+ * \pre poses sorted by time and not empty.
+ */
+[[nodiscard]] Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double time);
+
+/**
+ * \brief Reads `width height fx fy cx cy` (one line, `#` comments) [px].
+ * \throws std::runtime_error naming the file when it cannot be read or parsed.
+ */
+[[nodiscard]] CameraIntrinsics read_intrinsics_file(const std::string& path);
+
+/// \brief Writes what read_intrinsics_file() reads.
+/// \throws std::runtime_error naming the file when it cannot be written.
+void write_intrinsics_file(const std::string& path, const CameraIntrinsics& k);
+
+}  // namespace ofv

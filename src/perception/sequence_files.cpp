@@ -1,0 +1,110 @@
+// Pose and intrinsics text files of the recorded-sequence formats.
+#include "ofv/sources/sequence_files.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace ofv {
+
+std::vector<StampedPose> read_pose_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot open the pose file");
+  }
+  std::vector<StampedPose> poses;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') {
+      continue;
+    }
+    std::istringstream fields(line);
+    double t = 0, tx = 0, ty = 0, tz = 0, qx = 0, qy = 0, qz = 0, qw = 0;
+    if (!(fields >> t >> tx >> ty >> tz >> qx >> qy >> qz >> qw)) {
+      throw std::runtime_error(path + ":" + std::to_string(number) +
+                               ": expected 't tx ty tz qx qy qz qw', got '" + line + "'");
+    }
+    const Eigen::Quaterniond q(qw, qx, qy, qz);
+    if (!(q.norm() > 1e-6) || !std::isfinite(q.norm()) || !std::isfinite(tx + ty + tz + t)) {
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose '" + line + "'");
+    }
+    StampedPose p;
+    p.time = t;
+    p.wMc.linear() = q.normalized().toRotationMatrix();
+    p.wMc.translation() = Eigen::Vector3d(tx, ty, tz);
+    poses.push_back(p);
+  }
+  std::stable_sort(poses.begin(), poses.end(),
+                   [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; });
+  return poses;
+}
+
+std::string format_pose_line(double time, const Eigen::Isometry3d& wMc) {
+  const Eigen::Quaterniond q(wMc.linear());
+  const Eigen::Vector3d t = wMc.translation();
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", time, t.x(),
+                t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  return buffer;
+}
+
+Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double time) {
+  const auto after = std::lower_bound(poses.begin(), poses.end(), time,
+                                      [](const StampedPose& p, double t) { return p.time < t; });
+  if (after == poses.begin()) {
+    return poses.front().wMc;
+  }
+  if (after == poses.end()) {
+    return poses.back().wMc;
+  }
+  const StampedPose& b = *after;
+  const StampedPose& a = *(after - 1);
+  const double span = b.time - a.time;
+  const double s = span > 0.0 ? (time - a.time) / span : 0.0;
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(a.wMc.linear())
+                     .slerp(s, Eigen::Quaterniond(b.wMc.linear()))
+                     .toRotationMatrix();
+  out.translation() = (1.0 - s) * a.wMc.translation() + s * b.wMc.translation();
+  return out;
+}
+
+CameraIntrinsics read_intrinsics_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot open the intrinsics file");
+  }
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') {
+      continue;
+    }
+    std::istringstream fields(line);
+    CameraIntrinsics k;
+    if (!(fields >> k.width >> k.height >> k.fx >> k.fy >> k.cx >> k.cy) || k.width <= 0 ||
+        k.height <= 0 || !(k.fx > 0.0) || !(k.fy > 0.0)) {
+      throw std::runtime_error(path + ": expected 'width height fx fy cx cy', got '" + line + "'");
+    }
+    return k;
+  }
+  throw std::runtime_error(path + ": no 'width height fx fy cx cy' line");
+}
+
+void write_intrinsics_file(const std::string& path, const CameraIntrinsics& k) {
+  std::ofstream out(path);
+  out.precision(10);
+  out << "# width height fx fy cx cy [px]\n"
+      << k.width << ' ' << k.height << ' ' << k.fx << ' ' << k.fy << ' ' << k.cx << ' ' << k.cy
+      << '\n';
+  if (!out) {
+    throw std::runtime_error(path + ": cannot write the intrinsics file");
+  }
+}
+
+}  // namespace ofv
