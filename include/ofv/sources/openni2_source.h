@@ -1,0 +1,126 @@
+/**
+ * \file openni2_source.h
+ * \brief OpenNI2 devices and `.oni` recordings as frame sources, and a
+ *        writer of `.oni` recordings from any frames.
+ *
+ * OpenNI2 gives depth in the depth camera's pixels; with registration on,
+ * the device maps depth onto the colour image (what RgbdFrame expects).
+ * Intrinsics come from the streams' fields of view (principal point at the
+ * image centre) unless given. OpenNI2 records no camera pose: a recording
+ * made by OniWriter carries its poses in `PATH.poses.txt` (TUM pose lines),
+ * which OpenNi2Source reads when present; otherwise wMc is the identity.
+ */
+#pragma once
+
+#include "ofv/frame_source.h"
+#include "ofv/sources/sequence_files.h"
+
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+/// \brief Options of OpenNi2Source.
+struct OpenNi2Options {
+  /// Map depth onto the colour image (live devices that support it; a
+  /// recording keeps whatever registration it was made with).
+  bool registration = true;
+  /// Recordings only: 1 = real time, 2 = twice as fast, 0 = as fast as
+  /// possible, -1 = one frame each time next() asks (no frame is skipped).
+  float playback_speed = -1.0f;
+  int timeout_ms = 3000;  ///< longest wait for a frame [ms]
+  std::optional<CameraIntrinsics> intrinsics;  ///< overrides the fields of view
+  bool colour = true;  ///< also read the colour stream when there is one
+};
+
+/**
+ * \brief Frames from an OpenNI2 device (URI, e.g. a PrimeSense device URI,
+ *        `Dummy`) or a `.oni` file.
+ *
+ * Depth 1 mm or 100 um and RGB888 colour are supported; colour of another
+ * size than depth is resized (nearest neighbour). Rewind a recording with
+ * rewind(): OpenNI2's seek crashes inside libOniFile, so it closes and
+ * reopens the file.
+ */
+class OpenNi2Source : public FrameSource {
+ public:
+  /// \throws std::runtime_error naming the URI or path when OpenNI2 cannot
+  /// initialise, the device or file cannot be opened, or it has no depth stream.
+  explicit OpenNi2Source(const std::string& uri, const OpenNi2Options& options = {});
+  ~OpenNi2Source() override;
+  OpenNi2Source(const OpenNi2Source&) = delete;
+  OpenNi2Source& operator=(const OpenNi2Source&) = delete;
+
+  /// The next frame; std::nullopt at the end of a recording.
+  /// \throws std::runtime_error naming the URI when a frame does not arrive in time.
+  std::optional<RgbdFrame> next() override;
+  [[nodiscard]] std::string describe() const override;
+  /// True for a `.oni` recording.
+  [[nodiscard]] bool is_file() const;
+  /// Depth frames in a recording (0 for a live device).
+  [[nodiscard]] int number_of_frames() const;
+  /// Starts a recording again from its first frame (close and reopen).
+  void rewind();
+
+ private:
+  struct Impl;
+  std::string uri_;
+  OpenNi2Options options_;
+  std::unique_ptr<Impl> impl_;
+};
+
+/**
+ * \brief Writes frames to a `.oni` recording that OpenNI2's own player reads:
+ *        uncompressed depth (1 mm, 16 bits) and RGB888 nodes with their video
+ *        mode, field of view and cropping records, in the OpenNI2 record
+ *        format (file format 1.0.1.0). Poses go to `PATH.poses.txt`.
+ *
+ * All frames must have the size and intrinsics of the first; colour is
+ * written when the first frame has it. The file is complete after close()
+ * (or destruction).
+ */
+class OniWriter {
+ public:
+  /// \throws std::runtime_error naming the path when it cannot be created.
+  explicit OniWriter(const std::string& path, int fps = 30);
+  ~OniWriter();
+  OniWriter(const OniWriter&) = delete;
+  OniWriter& operator=(const OniWriter&) = delete;
+
+  /// Depth is stored in millimetres (0 where missing, clamped at 65.535 m).
+  /// \throws std::invalid_argument when the frame differs in size, or has colour
+  /// unlike the first; std::runtime_error when writing fails.
+  void write(const RgbdFrame& frame);
+  /// Patches the frame counts and ends the file. Idempotent.
+  void close();
+  [[nodiscard]] int count() const { return count_; }
+
+ private:
+  struct Node {
+    std::uint32_t id = 0;
+    std::uint64_t added_position = 0;  // NODE_ADDED record, patched on close
+    std::uint64_t last_data_position = 0;
+  };
+  void write_node_header(Node& node, bool depth, const CameraIntrinsics& k);
+  void write_data_begin(const Node& node);
+  void write_frame(Node& node, std::uint64_t timestamp_us, const void* data, std::size_t bytes);
+  void write_node_added(const Node& node, bool depth, std::uint32_t frames, std::uint64_t max_time);
+
+  std::string path_;
+  int fps_;
+  std::ofstream out_;
+  std::ofstream poses_;
+  Node depth_, image_;
+  bool has_colour_ = false;
+  CameraIntrinsics intrinsics_;
+  int count_ = 0;
+  std::uint64_t first_time_us_ = 0;
+  std::uint64_t last_time_us_ = 0;
+  bool closed_ = false;
+  std::vector<std::uint16_t> depth_buffer_;
+};
+
+}  // namespace ofv
