@@ -22,4 +22,7 @@ const char* estimator_settings_help();
 /// Registers `ofv estimate` on the app.
 Command add_estimate_command(CLI::App& app);
 
+/// Registers `ofv perceive` (perception front end + estimator over a source) on the app.
+Command add_perceive_command(CLI::App& app);
+
 }  // namespace ofv::cli

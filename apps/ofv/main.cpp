@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Print the help of every command");
 
-  const std::vector<Command> commands{add_estimate_command(app)};
+  const std::vector<Command> commands{add_estimate_command(app), add_perceive_command(app)};
   app.footer(estimator_settings_help());
 
   std::string known;

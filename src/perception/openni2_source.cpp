@@ -31,8 +31,20 @@ void initialise_openni() {
   }
 }
 
+/// OpenNI2's extended error on one line (it comes tab-indented, one line per layer).
 std::string last_error() {
-  const std::string e = openni::OpenNI::getExtendedError();
+  std::string e;
+  for (const char* c = openni::OpenNI::getExtendedError(); *c != '\0'; ++c) {
+    const bool space = *c == '\n' || *c == '\t' || *c == '\r' || *c == ' ';
+    if (!space) {
+      e += *c;
+    } else if (!e.empty() && e.back() != ' ') {
+      e += ' ';
+    }
+  }
+  while (!e.empty() && e.back() == ' ') {
+    e.pop_back();
+  }
   return e.empty() ? "unknown OpenNI2 error" : e;
 }
 

@@ -1,0 +1,275 @@
+// `ofv perceive SOURCE [--out DIR] [--pictures]`: the perception front end
+// and the estimator on every frame of a recording or device.
+#include "commands.h"
+#include "perception_picture.h"
+
+#include "ofv/estimator.h"
+#include "ofv/io/scene_json.h"
+#include "ofv/perception/perception.h"
+#include "ofv/sources/openni2_source.h"
+#include "ofv/sources/pcd_sequence.h"
+#include "ofv/sources/tum_sequence.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace ofv::cli {
+
+namespace {
+
+constexpr const char* kSourceHelp = R"(Sources:
+  DIR                 a TUM RGB-D sequence (depth.txt, rgb.txt, depth/, rgb/, groundtruth.txt)
+  DIR                 a PCD sequence (*.pcd organised clouds, camera frame, + poses.txt)
+  FILE.oni            an OpenNI2 recording (poses from FILE.oni.poses.txt if present)
+  openni2://URI       a live OpenNI2 device (openni2:// alone: the first device)
+
+Output: with --out DIR, DIR/frame_NNNNNN.json per frame ({"frame", "timestamp", "status",
+"problem" (a scene for 'ofv estimate'), "estimate", "counts", "timings_ms"}) and, with
+--pictures, DIR/frame_NNNNNN.png; without --out, one JSON object per line on stdout.
+A summary goes to stderr. Exit 0 ok, 1 runtime failure, 2 bad input (one line on stderr).
+)";
+
+std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) {
+        throw std::invalid_argument(item);
+      }
+    } catch (const std::exception&) {
+      throw std::invalid_argument(option + " " + text + ": '" + item + "' is not a number");
+    }
+  }
+  if (values.size() != count) {
+    throw std::invalid_argument(option + " " + text + ": expected " + std::to_string(count) +
+                                " comma-separated numbers");
+  }
+  return values;
+}
+
+std::unique_ptr<FrameSource> open_source(const std::string& source, float speed) {
+  OpenNi2Options oni;
+  oni.playback_speed = speed;
+  const std::string scheme = "openni2://";
+  if (source.rfind(scheme, 0) == 0) {
+    const std::string uri = source.substr(scheme.size());
+    return std::make_unique<OpenNi2Source>(uri.empty() ? std::string() : uri, oni);
+  }
+  if (source.size() > 4 && source.compare(source.size() - 4, 4, ".oni") == 0) {
+    if (!fs::is_regular_file(source)) {
+      throw std::invalid_argument(source + ": no such .oni file");
+    }
+    return std::make_unique<OpenNi2Source>(source, oni);
+  }
+  if (fs::is_directory(source)) {
+    if (fs::exists(fs::path(source) / "depth.txt")) {
+      return std::make_unique<TumSequenceSource>(source);
+    }
+    for (const auto& entry : fs::directory_iterator(source)) {
+      if (entry.path().extension() == ".pcd") {
+        return std::make_unique<PcdSequenceSource>(source);
+      }
+    }
+  }
+  throw std::invalid_argument(source +
+                              ": not a TUM RGB-D directory, a PCD sequence, a .oni file or an "
+                              "openni2:// URI");
+}
+
+nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
+  return {{"valid_pixels", c.valid_pixels}, {"cropped_points", c.cropped_points},
+          {"voxels", c.voxels},             {"supervoxels", c.supervoxels},
+          {"adjacency_edges", c.adjacency_edges}, {"object", c.object},
+          {"object_voxels", c.object_voxels}, {"interacting", c.interacting},
+          {"occluders", c.occluders}};
+}
+
+nlohmann::ordered_json timings_json(const PerceptionTimings& t, double estimate_ms) {
+  return {{"cloud", t.cloud},       {"supervoxels", t.supervoxels}, {"adjacency", t.adjacency},
+          {"tracking", t.tracking}, {"classify", t.classify},       {"front_end", t.total},
+          {"estimate", estimate_ms}};
+}
+
+}  // namespace
+
+Command add_perceive_command(CLI::App& app) {
+  struct Options {
+    std::string source;
+    std::string out;
+    bool pictures = false;
+    std::vector<std::string> sets;
+    std::string box;
+    std::string rect;
+    int max_frames = -1;
+    float speed = -1.0f;
+    double voxel = 0.008;
+    double obb_margin = 0.03;
+    double max_motion = 0.012;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "perceive", "Run the perception front end and the estimator on every frame of a source");
+  sub->add_option("source", opt->source, "TUM directory, PCD sequence, FILE.oni or openni2://URI")
+      ->required();
+  sub->add_option("--out", opt->out, "Write frame_NNNNNN.json (and .png) into this directory");
+  sub->add_flag("--pictures", opt->pictures, "Also draw a PNG per frame (needs --out)");
+  sub->add_option("--set", opt->sets,
+                  "Estimator setting name=value (repeatable); r_seed and r_sphere also set the "
+                  "supervoxel seed resolution and the sphere of the front end")
+      ->type_name("NAME=VALUE");
+  sub->add_option("--box", opt->box, "Select the object in frame 0 by a world box [m]")
+      ->type_name("X0,Y0,Z0,X1,Y1,Z1");
+  sub->add_option("--rect", opt->rect, "Select the object in frame 0 by an image rectangle [px]")
+      ->type_name("U0,V0,U1,V1");
+  sub->add_option("--max-frames", opt->max_frames, "Stop after this many frames");
+  sub->add_option("--speed", opt->speed,
+                  "Playback speed of .oni files: 1 real time, 0 fastest, -1 every frame (default)");
+  sub->add_option("--voxel", opt->voxel, "Voxel resolution [m] (default 0.008)");
+  sub->add_option("--obb-margin", opt->obb_margin, "Augmentation of the object's OBB [m] (default 0.03)");
+  sub->add_option("--max-motion", opt->max_motion,
+                  "Largest object motion between frames [m] (default 0.012)");
+  sub->footer(kSourceHelp);
+
+  return {sub, [opt]() -> int {
+            std::unique_ptr<FrameSource> source;
+            EstimatorParams params;
+            EstimatorSettings settings;
+            PerceptionSettings ps;
+            try {
+              if (opt->pictures && opt->out.empty()) {
+                throw std::invalid_argument("--pictures needs --out DIR");
+              }
+              for (const std::string& assignment : opt->sets) {
+                const auto eq = assignment.find('=');
+                if (eq == std::string::npos || eq == 0) {
+                  throw std::invalid_argument("--set " + assignment + ": expected name=value");
+                }
+                set_param(params, assignment.substr(0, eq), assignment.substr(eq + 1));
+              }
+              settings = params.resolve();
+              ps.supervoxels.seed_resolution = settings.r_seed;
+              ps.supervoxels.voxel_resolution = opt->voxel;
+              ps.r_sphere = settings.r_sphere;
+              ps.obb_margin = opt->obb_margin;
+              ps.tracking.max_motion = opt->max_motion;
+              if (!opt->box.empty()) {
+                const auto b = parse_numbers(opt->box, 6, "--box");
+                ps.selection.mode = ObjectSelection::Mode::Box;
+                ps.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]),
+                                                       Eigen::Vector3d(b[3], b[4], b[5]));
+              } else if (!opt->rect.empty()) {
+                const auto b = parse_numbers(opt->rect, 4, "--rect");
+                ps.selection.mode = ObjectSelection::Mode::Image;
+                ps.selection.rect = Eigen::AlignedBox2i(
+                    Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
+                    Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
+              }
+              validate(ps);
+              source = open_source(opt->source, opt->speed);
+              if (!opt->out.empty()) {
+                std::error_code ec;
+                fs::create_directories(opt->out, ec);
+                if (!fs::is_directory(opt->out)) {
+                  throw std::invalid_argument(opt->out + ": cannot create the output directory");
+                }
+              }
+            } catch (const std::invalid_argument& e) {
+              std::cerr << "ofv perceive: " << e.what() << '\n';
+              return kUsage;
+            } catch (const std::exception& e) {
+              // Sources report unreadable paths and absent devices as runtime errors:
+              // at start-up they are bad input.
+              std::cerr << "ofv perceive: " << e.what() << '\n';
+              return kUsage;
+            }
+
+            try {
+              Perception perception(ps);
+              std::optional<Eigen::Vector3d> previous_view;
+              int frames = 0, lost = 0;
+              std::vector<double> front_end_ms;
+              while (opt->max_frames < 0 || frames < opt->max_frames) {
+                const std::optional<RgbdFrame> frame = source->next();
+                if (!frame) {
+                  break;
+                }
+                const PerceptionResult r = perception.process(*frame);
+                front_end_ms.push_back(r.timings.total);
+                nlohmann::ordered_json j;
+                j["frame"] = frames;
+                j["timestamp"] = frame->timestamp;
+                j["status"] = to_string(r.status);
+                if (!r.message.empty()) {
+                  j["message"] = r.message;
+                }
+                std::optional<ViewEstimate> estimate;
+                double estimate_ms = 0.0;
+                if (r.status != TrackingStatus::Lost) {
+                  Scene scene{r.problem, params};
+                  scene.problem.previous_view = previous_view;
+                  const auto start = std::chrono::steady_clock::now();
+                  estimate = estimate_view(scene.problem, settings);
+                  estimate_ms = std::chrono::duration<double, std::milli>(
+                                    std::chrono::steady_clock::now() - start)
+                                    .count();
+                  previous_view = estimate->tf;
+                  j["problem"] = scene_to_json(scene);
+                  j["estimate"] = estimate_to_json(*estimate);
+                } else {
+                  ++lost;
+                  j["problem"] = nullptr;
+                  j["estimate"] = nullptr;
+                }
+                j["counts"] = counts_json(r.counts);
+                j["timings_ms"] = timings_json(r.timings, estimate_ms);
+                if (opt->out.empty()) {
+                  std::cout << j.dump() << '\n';
+                } else {
+                  char name[32];
+                  std::snprintf(name, sizeof name, "frame_%06d", frames);
+                  const fs::path base = fs::path(opt->out) / name;
+                  std::ofstream file(base.string() + ".json");
+                  file << j.dump(2) << '\n';
+                  if (!file) {
+                    throw std::runtime_error(base.string() + ".json: cannot write");
+                  }
+                  if (opt->pictures) {
+                    save_perception_picture(base.string() + ".png", *frame, r, estimate,
+                                            settings.r_sphere);
+                  }
+                }
+                ++frames;
+              }
+              std::sort(front_end_ms.begin(), front_end_ms.end());
+              const double median = front_end_ms.empty() ? 0.0 : front_end_ms[front_end_ms.size() / 2];
+              std::cerr << "ofv perceive: " << source->describe() << ": " << frames << " frames, "
+                        << lost << " lost, front end median " << median << " ms\n";
+              return kOk;
+            } catch (const std::invalid_argument& e) {
+              std::cerr << "ofv perceive: " << e.what() << '\n';
+              return kUsage;
+            } catch (const std::exception& e) {
+              std::cerr << "ofv perceive: " << e.what() << '\n';
+              return kRuntimeFailure;
+            }
+          }};
+}
+
+}  // namespace ofv::cli

@@ -1,0 +1,142 @@
+// End to end: `ofv perceive` on recordings written by the sources' writers.
+#include "ofv/sources/openni2_source.h"
+#include "ofv/sources/tum_sequence.h"
+
+#include "synthetic_scene.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace ofv {
+namespace {
+
+struct CommandRun {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+CommandRun run(const std::string& args) {
+  const fs::path err = fs::path(testing::TempDir()) / "ofv_perceive_stderr.txt";
+  const std::string command = std::string(OFV_BINARY) + " " + args + " 2>" + err.string();
+  CommandRun r;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) {
+    return r;
+  }
+  char buffer[4096];
+  std::size_t n = 0;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) {
+    r.out.append(buffer, n);
+  }
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+/// Frame 0 sees the case alone; then a hand grips it and an arm passes in front.
+std::vector<RgbdFrame> episode() {
+  std::vector<RgbdFrame> frames;
+  const Eigen::Vector3d skin(225, 170, 140);
+  for (int k = 0; k < 4; ++k) {
+    test::SyntheticScene scene = test::table_and_case();
+    if (k >= 1) {
+      scene.shapes.push_back(test::make_capsule({0.115, -0.005, 0.03}, {0.115, -0.005, 0.12}, 0.02,
+                                                skin, test::kHand));
+    }
+    if (k >= 2) {
+      scene.shapes.push_back(test::make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025,
+                                                skin, test::kHand));
+    }
+    frames.push_back(scene.render(test::vga(320), test::front_camera(), nullptr, k / 30.0));
+  }
+  return frames;
+}
+
+TEST(PerceiveCli, TumSequenceGivesProblemsForOfvEstimateAndPictures) {
+  const fs::path dir = fs::path(testing::TempDir()) / "ofv_perceive_tum";
+  const fs::path out = fs::path(testing::TempDir()) / "ofv_perceive_out";
+  fs::remove_all(dir);
+  fs::remove_all(out);
+  {
+    TumSequenceWriter writer(dir.string());
+    for (const RgbdFrame& f : episode()) {
+      writer.write(f);
+    }
+  }
+  const CommandRun r = run("perceive " + dir.string() + " --out " + out.string() + " --pictures");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("4 frames, 0 lost"), std::string::npos) << r.err;
+  for (int k = 0; k < 4; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06d", k);
+    ASSERT_TRUE(fs::exists(out / (std::string(name) + ".png"))) << name;
+    std::ifstream in(out / (std::string(name) + ".json"));
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["status"], k == 0 ? "initialised" : "tracking");
+    EXPECT_GE(j["problem"]["supervoxels"].size(), 10u);
+    EXPECT_EQ(j["counts"]["occluders"].get<std::size_t>(), j["problem"]["occluders"].size());
+    if (k >= 1) {
+      EXPECT_GE(j["counts"]["interacting"].get<int>(), 1) << "frame " << k;
+    }
+    // The problem is a scene for `ofv estimate`, which gives the same t0.
+    const fs::path scene = out / (std::string(name) + ".scene.json");
+    std::ofstream(scene) << j["problem"].dump();
+    const CommandRun e = run("estimate --compact " + scene.string());
+    ASSERT_EQ(e.code, 0) << e.err;
+    const auto estimate = nlohmann::json::parse(e.out);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(estimate["t0"][i].get<double>(), j["estimate"]["t0"][i].get<double>(), 1e-9);
+    }
+  }
+}
+
+TEST(PerceiveCli, OniRecordingStreamsJsonLines) {
+  const fs::path oni = fs::path(testing::TempDir()) / "ofv_perceive.oni";
+  {
+    OniWriter writer(oni.string());
+    for (const RgbdFrame& f : episode()) {
+      writer.write(f);
+    }
+  }
+  const CommandRun r = run("perceive " + oni.string() + " --max-frames 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  int n = 0;
+  while (std::getline(lines, line)) {
+    const auto j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["frame"], n);
+    EXPECT_NE(j["status"], "lost");
+    ++n;
+  }
+  EXPECT_EQ(n, 3);
+}
+
+TEST(PerceiveCli, BadInputIsExitTwoWithOneLine) {
+  for (const std::string& args :
+       {std::string("perceive /no/such/dir"), std::string("perceive /no/such/file.oni"),
+        std::string("perceive openni2://no-such-device"),
+        std::string("perceive ") + testing::TempDir() + " --box 1,2,3",
+        std::string("perceive ") + testing::TempDir() + " --pictures"}) {
+    const CommandRun r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+}
+
+}  // namespace
+}  // namespace ofv
