@@ -14,7 +14,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Print the help of every command");
 
-  const std::vector<Command> commands{add_estimate_command(app), add_perceive_command(app)};
+  std::vector<Command> commands{add_estimate_command(app)};
+#ifdef OFV_HAVE_PERCEPTION  // built with the perception front end (OFV_BUILD_PERCEPTION)
+  commands.push_back(add_perceive_command(app));
+#endif
   app.footer(estimator_settings_help());
 
   std::string known;
