@@ -102,10 +102,13 @@ TEST(Perception, NormalsFaceTheCameraAndAdjacencyRespectsRadius) {
   }
 }
 
-TEST(Perception, HandHoldingTheCaseIsInteractingNotObject) {
+class HandHolding : public testing::TestWithParam<int> {};
+
+TEST_P(HandHolding, HandIsInteractingNotObject) {
+  const int width = GetParam();
   Perception perception{PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
-  ASSERT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
+  ASSERT_EQ(perception.process(render(test::table_and_case(), wMc, width).frame).status,
             TrackingStatus::Initialised);
   // The hand comes in from the right, 1 cm per frame, and grips the edge.
   PerceptionResult r;
@@ -113,7 +116,7 @@ TEST(Perception, HandHoldingTheCaseIsInteractingNotObject) {
   for (int step = 5; step >= 0; --step) {
     test::SyntheticScene scene = test::table_and_case();
     scene.shapes.push_back(holding_hand(0.01 * step));
-    f = render(scene, wMc);
+    f = render(scene, wMc, width);
     r = perception.process(f.frame);
     ASSERT_EQ(r.status, TrackingStatus::Tracking) << "step " << step << ": " << r.message;
   }
@@ -125,6 +128,8 @@ TEST(Perception, HandHoldingTheCaseIsInteractingNotObject) {
   EXPECT_GE(score.recall, 0.90);
   EXPECT_LE((r.centroid - test::truth_centroid(r, f.frame, f.labels, kObject)).norm(), 0.01);
 }
+
+INSTANTIATE_TEST_SUITE_P(Perception, HandHolding, testing::Values(640, 320));
 
 TEST(Perception, ArmInFrontIsAnOccluderAndMovesTheView) {
   Perception perception{PerceptionSettings{}};
