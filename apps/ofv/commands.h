@@ -1,9 +1,13 @@
 // The `ofv` command line: one function per subcommand.
 #pragma once
 
+#include "ofv/estimator.h"
+
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace ofv::cli {
 
@@ -18,6 +22,10 @@ struct Command {
 
 /// The estimator settings, their defaults and units, for every command's help.
 const char* estimator_settings_help();
+
+/// Applies `--set name=value` assignments in order.
+/// \throws std::invalid_argument naming the assignment when it is malformed or invalid.
+void apply_sets(EstimatorParams& params, const std::vector<std::string>& assignments);
 
 /// Registers `ofv estimate` on the app.
 Command add_estimate_command(CLI::App& app);

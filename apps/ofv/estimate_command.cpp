@@ -56,6 +56,16 @@ angular_error_deg) on stdout. Exit 0 ok, 2 bad input (one line on stderr).)";
 
 }  // namespace
 
+void apply_sets(EstimatorParams& params, const std::vector<std::string>& assignments) {
+  for (const std::string& assignment : assignments) {
+    const auto eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw std::invalid_argument("--set " + assignment + ": expected name=value");
+    }
+    set_param(params, assignment.substr(0, eq), assignment.substr(eq + 1));
+  }
+}
+
 Command add_estimate_command(CLI::App& app) {
   struct Options {
     std::string scene;
@@ -76,14 +86,7 @@ Command add_estimate_command(CLI::App& app) {
   return {sub, [opt]() -> int {
             try {
               Scene scene = read_scene(opt->scene);
-              for (const std::string& assignment : opt->sets) {
-                const auto eq = assignment.find('=');
-                if (eq == std::string::npos || eq == 0) {
-                  throw std::invalid_argument("--set " + assignment +
-                                              ": expected name=value");
-                }
-                set_param(scene.params, assignment.substr(0, eq), assignment.substr(eq + 1));
-              }
+              apply_sets(scene.params, opt->sets);
               EstimateOptions options;
               options.record_path = opt->path;
               ViewEstimate estimate;

@@ -156,13 +156,7 @@ Command add_perceive_command(CLI::App& app) {
               if (opt->pictures && opt->out.empty()) {
                 throw std::invalid_argument("--pictures needs --out DIR");
               }
-              for (const std::string& assignment : opt->sets) {
-                const auto eq = assignment.find('=');
-                if (eq == std::string::npos || eq == 0) {
-                  throw std::invalid_argument("--set " + assignment + ": expected name=value");
-                }
-                set_param(params, assignment.substr(0, eq), assignment.substr(eq + 1));
-              }
+              apply_sets(params, opt->sets);
               settings = params.resolve();
               ps.supervoxels.seed_resolution = settings.r_seed;
               ps.supervoxels.voxel_resolution = opt->voxel;

@@ -10,6 +10,11 @@
 
 namespace ofv {
 
+bool is_blank_or_comment(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t\r");
+  return first == std::string::npos || line[first] == '#';
+}
+
 std::vector<StampedPose> read_pose_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) {
@@ -20,7 +25,7 @@ std::vector<StampedPose> read_pose_file(const std::string& path) {
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') {
+    if (is_blank_or_comment(line)) {
       continue;
     }
     std::istringstream fields(line);
@@ -81,8 +86,7 @@ CameraIntrinsics read_intrinsics_file(const std::string& path) {
   }
   std::string line;
   while (std::getline(in, line)) {
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') {
+    if (is_blank_or_comment(line)) {
       continue;
     }
     std::istringstream fields(line);

@@ -36,8 +36,7 @@ std::vector<ListEntry> read_list(const std::string& path) {
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') {
+    if (is_blank_or_comment(line)) {
       continue;
     }
     std::istringstream fields(line);

@@ -15,6 +15,9 @@
 
 namespace ofv {
 
+/// \brief True for a line of a sequence text file that holds no data: blank or `#` comment.
+[[nodiscard]] bool is_blank_or_comment(const std::string& line);
+
 /// \brief A timestamped camera pose wMc (camera -> world), ViSP camera axes.
 struct StampedPose {
   double time = 0.0;  ///< [s]
