@@ -95,8 +95,9 @@ void OpenNi2Source::rewind() {
   }
   initialise_openni();
   auto impl = std::make_unique<Impl>();
-  if (impl->device.open(uri_.c_str()) != openni::STATUS_OK) {
-    throw std::runtime_error(uri_ + ": cannot open the OpenNI2 device or recording: " + last_error());
+  if (impl->device.open(uri_.empty() ? openni::ANY_DEVICE : uri_.c_str()) != openni::STATUS_OK) {
+    throw std::runtime_error((uri_.empty() ? std::string("first OpenNI2 device") : uri_) +
+                             ": cannot open the OpenNI2 device or recording: " + last_error());
   }
   impl->file = impl->device.isFile();
   if (!impl->device.hasSensor(openni::SENSOR_DEPTH) ||

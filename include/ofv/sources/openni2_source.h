@@ -47,6 +47,7 @@ struct OpenNi2Options {
  */
 class OpenNi2Source : public FrameSource {
  public:
+  /// An empty URI opens the first device OpenNI2 finds.
   /// \throws std::runtime_error naming the URI or path when OpenNI2 cannot
   /// initialise, the device or file cannot be opened, or it has no depth stream.
   explicit OpenNi2Source(const std::string& uri, const OpenNi2Options& options = {});
