@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <random>
 #include <vector>
 
 namespace ofv::test {
@@ -197,6 +198,41 @@ struct SyntheticScene {
     return f;
   }
 };
+
+/// Sensor-like depth noise: Gaussian with sigma = sigma_at_1m * Z^2, and
+/// pixels at depth discontinuities (a step above `edge_jump` to a neighbour)
+/// dropped with probability `edge_dropout`. Deterministic given `seed`.
+inline void add_depth_noise(RgbdFrame& f, unsigned seed, double sigma_at_1m = 0.001,
+                            double edge_jump = 0.03, double edge_dropout = 0.5) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const std::vector<float> clean = f.depth;
+  const int w = f.intrinsics.width;
+  const int h = f.intrinsics.height;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const std::size_t i = f.index(u, v);
+      const double z = clean[i];
+      if (!(z > 0.0)) {
+        continue;
+      }
+      bool edge = false;
+      for (const auto& [du, dv] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+        const int nu = u + du, nv = v + dv;
+        if (nu >= 0 && nv >= 0 && nu < w && nv < h) {
+          const double zn = clean[f.index(nu, nv)];
+          edge = edge || !(zn > 0.0) || std::abs(zn - z) > edge_jump;
+        }
+      }
+      if (edge && uniform(rng) < edge_dropout) {
+        f.depth[i] = 0.0f;
+      } else {
+        f.depth[i] = static_cast<float>(z + sigma_at_1m * z * z * gauss(rng));
+      }
+    }
+  }
+}
 
 /// 640 x 480 or 320 x 240 intrinsics with a 615 px (or 307.5 px) focal length.
 inline CameraIntrinsics vga(int width = 640) {

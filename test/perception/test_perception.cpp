@@ -180,6 +180,33 @@ TEST(Perception, FollowsAMovingDeformingObject) {
   }
 }
 
+TEST(Perception, NoisyDepthKeepsTheObjectAndTheHandApart) {
+  // 1 mm at 1 m (growing with Z^2) and half the depth-edge pixels missing,
+  // as the simulator's sensor model.
+  for (const int width : {640, 320}) {
+    Perception perception{PerceptionSettings{}};
+    const Eigen::Isometry3d wMc = test::front_camera();
+    for (int k = 0; k < 6; ++k) {
+      test::SyntheticScene scene = test::table_and_case();
+      if (k > 0) {
+        scene.shapes.push_back(holding_hand(0.01 * (5 - k)));
+      }
+      Frame f = render(scene, wMc, width);
+      test::add_depth_noise(f.frame, 7u + static_cast<unsigned>(k));
+      const PerceptionResult r = perception.process(f.frame);
+      ASSERT_NE(r.status, TrackingStatus::Lost) << width << " frame " << k << ": " << r.message;
+      const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+      const auto score = test::score_object(r, truth, kObject);
+      EXPECT_GE(score.precision, 0.95) << width << " frame " << k;
+      EXPECT_GE(score.recall, 0.90) << width << " frame " << k;
+      EXPECT_EQ(test::count_truth_as(r, truth, kHand, SupervoxelClass::Object), 0)
+          << width << " frame " << k;
+      EXPECT_LE((r.centroid - test::truth_centroid(r, f.frame, f.labels, kObject)).norm(), 0.01)
+          << width << " frame " << k;
+    }
+  }
+}
+
 TEST(Perception, MovingCameraKeepsTheObjectFixedInTheWorld) {
   Perception perception{PerceptionSettings{}};
   const test::SyntheticScene scene = test::table_and_case();
