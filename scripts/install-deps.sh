@@ -10,7 +10,7 @@ packages=(
   libpcl-dev
   libopencv-dev
   libopenni2-dev
-  libembree-dev libtbb-dev
+  libembree-dev libtbb-dev libassimp-dev
   nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox

@@ -30,6 +30,9 @@ void apply_sets(EstimatorParams& params, const std::vector<std::string>& assignm
 /// Registers `ofv estimate` on the app.
 Command add_estimate_command(CLI::App& app);
 
+/// Registers `ofv render` (a simulated frame to PNGs) on the app.
+Command add_render_command(CLI::App& app);
+
 /// Registers `ofv perceive` (perception front end + estimator over a source) on the app.
 Command add_perceive_command(CLI::App& app);
 

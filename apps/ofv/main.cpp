@@ -18,6 +18,9 @@ int main(int argc, char** argv) {
 #ifdef OFV_HAVE_PERCEPTION  // built with the perception front end (OFV_BUILD_PERCEPTION)
   commands.push_back(add_perceive_command(app));
 #endif
+#ifdef OFV_HAVE_SIM  // built with the simulator (OFV_BUILD_SIM)
+  commands.push_back(add_render_command(app));
+#endif
   app.footer(estimator_settings_help());
 
   std::string known;

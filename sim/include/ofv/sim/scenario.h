@@ -1,0 +1,111 @@
+/**
+ * \file scenario.h
+ * \brief Simulated scenarios: a YAML description (docs/scenarios.md) of the
+ *        sensor, the camera's start, the target object and its motion or
+ *        deformation, the element holding it, moving occluders, the table,
+ *        and the estimator, robot and controller settings.
+ *
+ * World frame W: metres; bodies move along timed waypoints.
+ */
+#pragma once
+
+#include "ofv/estimator.h"
+#include "ofv/rgbd_frame.h"
+#include "ofv/sim/mesh.h"
+
+#include <Eigen/Geometry>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace ofv::sim {
+
+/// \brief A timed pose: position [m] and roll-pitch-yaw [deg] (fixed axes x, y, z).
+struct Waypoint {
+  double t = 0.0;  ///< [s]
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();
+};
+
+/// \brief Piecewise motion through waypoints: linear in position, slerp in
+///        rotation; held still before the first and after the last.
+struct Motion {
+  std::vector<Waypoint> waypoints;  ///< sorted by t, at least one
+  /// \brief Pose of the body in the world at time t [s].
+  [[nodiscard]] Eigen::Isometry3d at(double t) const;
+};
+
+/// \brief Rotation from roll, pitch, yaw in degrees: Rz(yaw) Ry(pitch) Rx(roll).
+[[nodiscard]] Eigen::Matrix3d rpy_deg_to_matrix(const Eigen::Vector3d& rpy_deg);
+
+/// \brief What a body is to the perception and the metrics.
+enum class Role { Object, Interacting, Occluder, Background };
+
+/// \brief A rigid or deformable body of the scene.
+struct Body {
+  std::string name;
+  Role role = Role::Occluder;
+  std::string shape;                 ///< box, sphere, capsule, sheet, cloth, mesh, plane
+  TriangleMesh mesh;                 ///< at rest, body frame
+  Eigen::Vector3f colour{0.5f, 0.5f, 0.5f};  ///< RGB in [0, 1]
+  Motion motion;
+  /// Cloth only: travelling wave and bend along body x (see deform_sheet).
+  double wave_amplitude = 0.0, wave_length = 0.2, wave_frequency = 0.0, bend = 0.0;
+  [[nodiscard]] bool deformable() const { return shape == "cloth"; }
+  /// \brief The body's mesh in the world frame at time t.
+  [[nodiscard]] TriangleMesh world_mesh(double t) const;
+};
+
+/// \brief Depth noise of the simulated sensor.
+struct NoiseModel {
+  bool enabled = true;
+  double depth_sigma = 0.001;   ///< Gaussian sigma at 1 m; grows with depth^2 [m]
+  double grazing_deg = 78.0;    ///< pixels seen more obliquely than this are missing [deg]
+  double edge_jump = 0.03;      ///< depth step that makes a pixel an edge [m]
+  double edge_dropout = 0.5;    ///< probability that an edge pixel is missing
+};
+
+/// \brief The simulated RGB-D sensor.
+struct SensorSettings {
+  CameraIntrinsics intrinsics;  ///< default: the `fast-320` preset
+  double min_depth = 0.1;       ///< [m]
+  double max_depth = 3.0;       ///< [m]
+  NoiseModel noise;
+};
+
+/// \brief Intrinsics presets: `d435-640` (640x480, D435-like) and `fast-320` (320x240).
+[[nodiscard]] CameraIntrinsics intrinsics_preset(const std::string& name);
+
+/// \brief A whole scenario.
+struct Scenario {
+  std::string name;       ///< file stem
+  std::string path;       ///< file it came from
+  double duration = 4.0;  ///< [s]
+  double rate = 30.0;     ///< sensor rate [Hz]
+  unsigned seed = 1;      ///< sensor noise seed (frame k uses seed and k)
+  SensorSettings sensor;
+  Eigen::Isometry3d wMc_start = Eigen::Isometry3d::Identity();  ///< camera start pose
+  std::vector<Body> bodies;  ///< the object first
+  EstimatorParams estimator;
+  std::string robot = "camera";  ///< camera, viper850, afma6
+  std::map<std::string, std::string> controller;  ///< law, gain, ... (read by the servo layer)
+  double r_sphere() const { return estimator.r_sphere.value_or(0.5); }
+  double r_seed() const { return estimator.r_seed.value_or(0.02); }
+};
+
+/// \brief Parses a scenario from YAML text; `source` names it in errors.
+/// \throws std::invalid_argument naming the file, the key and the value.
+[[nodiscard]] Scenario scenario_from_yaml(const std::string& text, const std::string& source);
+
+/// \brief Loads a scenario file, or a built-in scenario by name (e.g. `dvd-one-hand`).
+[[nodiscard]] Scenario load_scenario(const std::string& path_or_name);
+
+/// \brief Folder of the built-in scenarios.
+[[nodiscard]] std::string builtin_scenario_dir();
+/// \brief Names of the built-in scenarios, sorted.
+[[nodiscard]] std::vector<std::string> builtin_scenarios();
+/// \brief The scenario `ofv simulate` runs when given none.
+constexpr const char* kDefaultScenario = "dvd-one-hand";
+
+}  // namespace ofv::sim

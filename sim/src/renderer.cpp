@@ -1,0 +1,349 @@
+// Embree ray casting of a scenario: RGB-D frames, labels and ground truth.
+#include "ofv/sim/renderer.h"
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace ofv::sim {
+
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+
+// A point on a mesh: triangle and barycentric coordinates (stays on the
+// surface when the mesh moves or deforms).
+struct SurfaceSample {
+  int triangle;
+  float u, v;
+};
+
+std::vector<SurfaceSample> sample_surface(const TriangleMesh& m, int count, unsigned seed) {
+  std::vector<double> cumulative;
+  double total = 0.0;
+  for (const auto& t : m.triangles) {
+    total += 0.5 * (m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]).cast<double>().norm();
+    cumulative.push_back(total);
+  }
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::vector<SurfaceSample> out;
+  out.reserve(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    const double a = uni(rng) * total;
+    const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), a);
+    const int tri = static_cast<int>(std::min<std::ptrdiff_t>(it - cumulative.begin(), static_cast<std::ptrdiff_t>(cumulative.size()) - 1));
+    double u = uni(rng), v = uni(rng);
+    if (u + v > 1.0) {
+      u = 1.0 - u;
+      v = 1.0 - v;
+    }
+    out.push_back({tri, static_cast<float>(u), static_cast<float>(v)});
+  }
+  return out;
+}
+
+struct WorldPoint {
+  Eigen::Vector3d p, n;  // position, outward unit normal
+};
+
+WorldPoint at(const TriangleMesh& m, const SurfaceSample& s) {
+  const auto& t = m.triangles[static_cast<std::size_t>(s.triangle)];
+  const Eigen::Vector3d a = m.vertices[t[0]].cast<double>(), b = m.vertices[t[1]].cast<double>(),
+                        c = m.vertices[t[2]].cast<double>();
+  return {(1.0 - s.u - s.v) * a + s.u * b + s.v * c, (b - a).cross(c - a).normalized()};
+}
+
+std::uint16_t label_of(const Body& b, int occluder_index) {
+  switch (b.role) {
+    case Role::Object: return kLabelObject;
+    case Role::Interacting: return kLabelInteracting;
+    case Role::Background: return kLabelBackground;
+    case Role::Occluder: return static_cast<std::uint16_t>(kLabelOccluder0 + occluder_index);
+  }
+  return kLabelNone;
+}
+
+// Cells of an r_seed grid: mean position and mean normal per cell, in a fixed order.
+void grid_cells(const std::vector<WorldPoint>& pts, double cell, Eigen::Matrix3Xd& positions,
+                Eigen::Matrix3Xd* normals) {
+  std::map<std::array<long, 3>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> cells;
+  std::map<std::array<long, 3>, int> counts;
+  for (const auto& w : pts) {
+    const std::array<long, 3> key{static_cast<long>(std::floor(w.p.x() / cell)),
+                                  static_cast<long>(std::floor(w.p.y() / cell)),
+                                  static_cast<long>(std::floor(w.p.z() / cell))};
+    auto& c = cells[key];
+    c.first += w.p;
+    c.second += w.n;
+    ++counts[key];
+  }
+  positions.resize(3, static_cast<Eigen::Index>(cells.size()));
+  if (normals != nullptr) normals->resize(3, static_cast<Eigen::Index>(cells.size()));
+  Eigen::Index k = 0;
+  for (const auto& [key, c] : cells) {
+    positions.col(k) = c.first / counts[key];
+    if (normals != nullptr) normals->col(k) = c.second.normalized();
+    ++k;
+  }
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<TriangleMesh> world;               // per body, at the current time
+  std::vector<std::uint16_t> labels;             // per body
+  std::vector<std::vector<SurfaceSample>> samples;  // per body
+  int object = 0;
+
+  ~Impl() {
+    if (scene != nullptr) rtcReleaseScene(scene);
+    if (device != nullptr) rtcReleaseDevice(device);
+  }
+
+  [[nodiscard]] bool occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray{};
+    ray.org_x = static_cast<float>(from.x());
+    ray.org_y = static_cast<float>(from.y());
+    ray.org_z = static_cast<float>(from.z());
+    const Eigen::Vector3d d = to - from;
+    ray.dir_x = static_cast<float>(d.x());
+    ray.dir_y = static_cast<float>(d.y());
+    ray.dir_z = static_cast<float>(d.z());
+    ray.tnear = 0.0f;
+    ray.tfar = static_cast<float>(1.0 - 1e-4);  // stop short of the point itself
+    ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(scene, &context, &ray);
+    return ray.tfar < 0.0f;
+  }
+};
+
+Renderer::Renderer(const Scenario& scenario, int surface_samples)
+    : scenario_(scenario), impl_(std::make_unique<Impl>()) {
+  impl_->device = rtcNewDevice("threads=1");
+  if (impl_->device == nullptr) throw std::runtime_error("Embree: cannot create a device");
+  int occluder = 0;
+  for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
+    const Body& b = scenario_.bodies[k];
+    impl_->labels.push_back(label_of(b, b.role == Role::Occluder ? occluder++ : 0));
+    if (b.role == Role::Object) impl_->object = static_cast<int>(k);
+    const int n = b.role == Role::Object ? surface_samples
+                                         : std::clamp(static_cast<int>(b.mesh.area() / (0.004 * 0.004)), 200, 20000);
+    impl_->samples.push_back(sample_surface(b.mesh, n, 7919u * static_cast<unsigned>(k + 1)));
+  }
+  set_time(0.0);
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::set_time(double t) {
+  if (t == time_) return;
+  time_ = t;
+  if (impl_->scene != nullptr) rtcReleaseScene(impl_->scene);
+  impl_->scene = rtcNewScene(impl_->device);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_LOW);
+  impl_->world.clear();
+  for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
+    impl_->world.push_back(scenario_.bodies[k].world_mesh(t));
+    const TriangleMesh& m = impl_->world.back();
+    RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), m.vertices.size()));
+    for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+      v[3 * i] = m.vertices[i].x();
+      v[3 * i + 1] = m.vertices[i].y();
+      v[3 * i + 2] = m.vertices[i].z();
+    }
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), m.triangles.size()));
+    for (std::size_t i = 0; i < m.triangles.size(); ++i) {
+      for (int j = 0; j < 3; ++j) idx[3 * i + static_cast<std::size_t>(j)] = static_cast<unsigned>(m.triangles[i][j]);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(impl_->scene, g, static_cast<unsigned>(k));
+    rtcReleaseGeometry(g);
+  }
+  rtcCommitScene(impl_->scene);
+}
+
+RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index) const {
+  return render(wMc, frame_index, scenario_.sensor.intrinsics, scenario_.sensor.noise.enabled);
+}
+
+RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
+                               const CameraIntrinsics& k, bool noise) const {
+  RenderedFrame out;
+  RgbdFrame& f = out.frame;
+  f.timestamp = time_;
+  f.intrinsics = k;
+  f.wMc = wMc;
+  const auto pixels = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
+  f.depth.assign(pixels, 0.0f);
+  f.rgb.assign(3 * pixels, 0);
+  out.labels.assign(pixels, kLabelNone);
+  std::vector<float> cos_incidence(pixels, 0.0f);
+  const SensorSettings& sensor = scenario_.sensor;
+  const Eigen::Matrix3d R = wMc.linear();
+  const Eigen::Vector3d o = wMc.translation();
+
+  auto render_rows = [&](int row0, int row1) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (int v = row0; v < row1; ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        // Camera ray with unit Z, so the hit distance is the depth Z.
+        const Eigen::Vector3d d = R * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+        RTCRayHit rh{};
+        rh.ray.org_x = static_cast<float>(o.x());
+        rh.ray.org_y = static_cast<float>(o.y());
+        rh.ray.org_z = static_cast<float>(o.z());
+        rh.ray.dir_x = static_cast<float>(d.x());
+        rh.ray.dir_y = static_cast<float>(d.y());
+        rh.ray.dir_z = static_cast<float>(d.z());
+        rh.ray.tnear = static_cast<float>(sensor.min_depth);
+        rh.ray.tfar = static_cast<float>(sensor.max_depth);
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(impl_->scene, &context, &rh);
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+        const std::size_t i = f.index(u, v);
+        const Eigen::Vector3d ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+        const double c = std::abs(ng.normalized().dot(d.normalized()));
+        f.depth[i] = rh.ray.tfar;
+        cos_incidence[i] = static_cast<float>(c);
+        out.labels[i] = impl_->labels[rh.hit.geomID];
+        const Eigen::Vector3f colour = scenario_.bodies[rh.hit.geomID].colour;
+        const float shade = static_cast<float>(0.35 + 0.65 * c);
+        for (int ch = 0; ch < 3; ++ch) {
+          f.rgb[3 * i + static_cast<std::size_t>(ch)] =
+              static_cast<std::uint8_t>(std::clamp(255.0f * colour[ch] * shade, 0.0f, 255.0f));
+        }
+      }
+    }
+  };
+  const int threads = std::max(1, std::min<int>(static_cast<int>(std::thread::hardware_concurrency()), 8));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) {
+    pool.emplace_back(render_rows, k.height * t / threads, k.height * (t + 1) / threads);
+  }
+  render_rows(0, k.height / threads);
+  for (auto& t : pool) t.join();
+
+  if (noise) {
+    // A generator per row, seeded from (scenario seed, frame, row): the same
+    // frame whatever the thread count.
+    const NoiseModel& m = sensor.noise;
+    const float cos_grazing = static_cast<float>(std::cos(m.grazing_deg * kDegToRad));
+    std::vector<float> clean = f.depth;
+    for (int v = 0; v < k.height; ++v) {
+      std::mt19937_64 rng(scenario_.seed * 0x9E3779B97F4A7C15ull ^
+                          (static_cast<std::uint64_t>(frame_index) << 20) ^ static_cast<std::uint64_t>(v));
+      std::normal_distribution<double> gauss(0.0, 1.0);
+      std::uniform_real_distribution<double> uni(0.0, 1.0);
+      for (int u = 0; u < k.width; ++u) {
+        const std::size_t i = f.index(u, v);
+        const float z = clean[i];
+        if (z <= 0.0f) continue;
+        bool edge = false;
+        for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+          const int uu = u + du, vv = v + dv;
+          if (uu < 0 || vv < 0 || uu >= k.width || vv >= k.height) continue;
+          const float zn = clean[f.index(uu, vv)];
+          edge = edge || zn <= 0.0f || std::abs(zn - z) > m.edge_jump;
+        }
+        const double noise_z = gauss(rng) * m.depth_sigma * z * z;
+        const double drop = uni(rng);
+        if (cos_incidence[i] < cos_grazing || (edge && drop < m.edge_dropout)) {
+          f.depth[i] = 0.0f;
+        } else {
+          f.depth[i] = static_cast<float>(z + noise_z);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {
+  ObjectTruth t;
+  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
+  const auto& samples = impl_->samples[static_cast<std::size_t>(impl_->object)];
+  const Eigen::Vector3d o = wMc.translation();
+  const Eigen::Isometry3d cMw = wMc.inverse();
+  const CameraIntrinsics& k = scenario_.sensor.intrinsics;
+  int facing = 0, seen = 0;
+  for (const auto& s : samples) {
+    const WorldPoint w = at(m, s);
+    t.centroid += w.p;
+    if (w.n.dot(o - w.p) <= 0.0) continue;
+    ++facing;
+    const Eigen::Vector3d pc = cMw * w.p;
+    if (pc.z() < scenario_.sensor.min_depth || pc.z() > scenario_.sensor.max_depth) continue;
+    const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
+    if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
+    if (!impl_->occluded(o, w.p)) ++seen;
+  }
+  t.centroid /= static_cast<double>(samples.size());
+  t.visible_fraction = facing > 0 ? static_cast<double>(seen) / facing : 0.0;
+  for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
+    if (scenario_.bodies[b].role != Role::Occluder) continue;
+    const auto& verts = impl_->world[b].vertices;
+    const bool inside = std::any_of(verts.begin(), verts.end(), [&](const Eigen::Vector3f& v) {
+      return (v.cast<double>() - t.centroid).norm() < r_sphere;
+    });
+    t.occluders_in_sphere += inside ? 1 : 0;
+  }
+  return t;
+}
+
+ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double r_seed,
+                                           double r_sphere, double obb_margin) const {
+  const Eigen::Vector3d o = wMc.translation();
+  const std::size_t obj = static_cast<std::size_t>(impl_->object);
+  // Object: camera-facing surface in r_seed cells; the OBB from all of it.
+  std::vector<WorldPoint> facing;
+  Eigen::Matrix3Xd all(3, static_cast<Eigen::Index>(impl_->samples[obj].size()));
+  Eigen::Index n = 0;
+  for (const auto& s : impl_->samples[obj]) {
+    const WorldPoint w = at(impl_->world[obj], s);
+    all.col(n++) = w.p;
+    if (w.n.dot(o - w.p) > 0.0) facing.push_back(w);
+  }
+  ViewProblem p;
+  grid_cells(facing, r_seed, p.positions, &p.normals);
+  const Eigen::Vector3d mean = all.rowwise().mean();
+  const Eigen::Matrix3Xd centred = all.colwise() - mean;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred * centred.transpose());
+  const Eigen::Matrix3d axes = eig.eigenvectors();
+  const Eigen::Vector3d half = (axes.transpose() * centred).cwiseAbs().rowwise().maxCoeff().array() + obb_margin;
+  const Eigen::Vector3d c = p.positions.cols() > 0 ? Eigen::Vector3d(p.positions.rowwise().mean()) : mean;
+
+  std::vector<WorldPoint> occluding;
+  for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
+    if (scenario_.bodies[b].role != Role::Occluder) continue;
+    for (const auto& s : impl_->samples[b]) {
+      const WorldPoint w = at(impl_->world[b], s);
+      if (w.n.dot(o - w.p) <= 0.0) continue;  // the sensor sees only this side
+      const bool in_obb = ((axes.transpose() * (w.p - mean)).cwiseAbs().array() <= half.array()).all();
+      if (!in_obb && (w.p - c).norm() < r_sphere) occluding.push_back(w);
+    }
+  }
+  grid_cells(occluding, r_seed, p.occluders, nullptr);
+  p.camera = o;
+  return p;
+}
+
+}  // namespace ofv::sim
