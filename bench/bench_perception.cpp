@@ -13,8 +13,10 @@ ofv::RgbdFrame scene_frame(int width) {
   using namespace ofv::test;
   SyntheticScene scene = table_and_case();
   const Eigen::Vector3d skin(225, 170, 140);
-  scene.shapes.push_back(make_capsule({0.115, -0.005, 0.03}, {0.115, -0.005, 0.12}, 0.02, skin, kHand));
-  scene.shapes.push_back(make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025, skin, kHand));
+  scene.shapes.push_back(
+      make_capsule({0.115, -0.005, 0.03}, {0.115, -0.005, 0.12}, 0.02, skin, kHand));
+  scene.shapes.push_back(
+      make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025, skin, kHand));
   return scene.render(vga(width), front_camera());
 }
 

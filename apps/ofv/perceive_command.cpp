@@ -42,7 +42,8 @@ Output: with --out DIR, DIR/frame_NNNNNN.json per frame ({"frame", "timestamp", 
 A summary goes to stderr. Exit 0 ok, 1 runtime failure, 2 bad input (one line on stderr).
 )";
 
-std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option) {
+std::vector<double> parse_numbers(const std::string& text, std::size_t count,
+                                  const std::string& option) {
   std::vector<double> values;
   std::stringstream in(text);
   std::string item;
@@ -94,10 +95,14 @@ std::unique_ptr<FrameSource> open_source(const std::string& source, float speed)
 }
 
 nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
-  return {{"valid_pixels", c.valid_pixels}, {"cropped_points", c.cropped_points},
-          {"voxels", c.voxels},             {"supervoxels", c.supervoxels},
-          {"adjacency_edges", c.adjacency_edges}, {"object", c.object},
-          {"object_voxels", c.object_voxels}, {"interacting", c.interacting},
+  return {{"valid_pixels", c.valid_pixels},
+          {"cropped_points", c.cropped_points},
+          {"voxels", c.voxels},
+          {"supervoxels", c.supervoxels},
+          {"adjacency_edges", c.adjacency_edges},
+          {"object", c.object},
+          {"object_voxels", c.object_voxels},
+          {"interacting", c.interacting},
           {"occluders", c.occluders}};
 }
 
@@ -142,7 +147,8 @@ Command add_perceive_command(CLI::App& app) {
   sub->add_option("--speed", opt->speed,
                   "Playback speed of .oni files: 1 real time, 0 fastest, -1 every frame (default)");
   sub->add_option("--voxel", opt->voxel, "Voxel resolution [m] (default 0.008)");
-  sub->add_option("--obb-margin", opt->obb_margin, "Augmentation of the object's OBB [m] (default 0.03)");
+  sub->add_option("--obb-margin", opt->obb_margin,
+                  "Augmentation of the object's OBB [m] (default 0.03)");
   sub->add_option("--max-motion", opt->max_motion,
                   "Largest object motion between frames [m] (default 0.012)");
   sub->footer(kSourceHelp);
@@ -252,7 +258,8 @@ Command add_perceive_command(CLI::App& app) {
                 ++frames;
               }
               std::sort(front_end_ms.begin(), front_end_ms.end());
-              const double median = front_end_ms.empty() ? 0.0 : front_end_ms[front_end_ms.size() / 2];
+              const double median =
+                  front_end_ms.empty() ? 0.0 : front_end_ms[front_end_ms.size() / 2];
               std::cerr << "ofv perceive: " << source->describe() << ": " << frames << " frames, "
                         << lost << " lost, front end median " << median << " ms\n";
               return kOk;

@@ -11,8 +11,8 @@
 #include <Eigen/Geometry>
 
 #include <array>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace ofv::cli {
@@ -46,7 +46,8 @@ class Observer {
     if (c.z() < 1e-3) {
       return std::nullopt;
     }
-    return vpImagePoint(focal_ * c.y() / c.z() + kHeight / 2.0, focal_ * c.x() / c.z() + kWidth / 2.0);
+    return vpImagePoint(focal_ * c.y() / c.z() + kHeight / 2.0,
+                        focal_ * c.x() / c.z() + kWidth / 2.0);
   }
 
  private:
@@ -75,8 +76,8 @@ void dot(vpImage<vpRGBa>& image, const Observer& obs, const Eigen::Vector3d& p,
 void square(vpImage<vpRGBa>& image, const Observer& obs, const Eigen::Vector3d& p,
             const vpColor& colour, double half = 3.0) {
   if (const auto ip = obs(p)) {
-    vpImageDraw::drawRectangle(image, vpRect(ip->get_j() - half, ip->get_i() - half, 2 * half, 2 * half),
-                               colour);
+    vpImageDraw::drawRectangle(
+        image, vpRect(ip->get_j() - half, ip->get_i() - half, 2 * half, 2 * half), colour);
   }
 }
 
@@ -156,13 +157,14 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
     std::array<Eigen::Vector3d, 8> corner;
     for (int k = 0; k < 8; ++k) {
       const Eigen::Vector3d s((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1);
-      corner[static_cast<std::size_t>(k)] = r.obb.centre + r.obb.axes * s.cwiseProduct(r.obb.half_extents);
+      corner[static_cast<std::size_t>(k)] =
+          r.obb.centre + r.obb.axes * s.cwiseProduct(r.obb.half_extents);
     }
     for (int k = 0; k < 8; ++k) {
       for (int bit : {1, 2, 4}) {
         if ((k & bit) == 0) {
-          line(image, obs, corner[static_cast<std::size_t>(k)], corner[static_cast<std::size_t>(k | bit)],
-               vpColor(60, 220, 120));
+          line(image, obs, corner[static_cast<std::size_t>(k)],
+               corner[static_cast<std::size_t>(k | bit)], vpColor(60, 220, 120));
         }
       }
     }
@@ -230,8 +232,9 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
   // Legend and figures.
   char line1[256];
   char line2[256];
-  std::snprintf(line1, sizeof line1, "t=%.3fs  %s  N=%zu  interacting=%zu  occluders=%zu", frame.timestamp,
-                to_string(r.status), r.counts.object, r.counts.interacting, r.counts.occluders);
+  std::snprintf(line1, sizeof line1, "t=%.3fs  %s  N=%zu  interacting=%zu  occluders=%zu",
+                frame.timestamp, to_string(r.status), r.counts.object, r.counts.interacting,
+                r.counts.occluders);
   text(image, font, line1, vpImagePoint(kHeight - 48, 10), vpColor::white);
   if (e) {
     std::snprintf(line2, sizeof line2, "%s, %d iterations, tf-t0 %.1f deg, front end %.1f ms",

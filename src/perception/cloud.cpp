@@ -14,8 +14,8 @@ void check_frame(const RgbdFrame& frame) {
                                 std::to_string(k.height) + ": expected a positive size");
   }
   if (!(std::isfinite(k.fx) && std::isfinite(k.fy) && k.fx > 0.0 && k.fy > 0.0)) {
-    throw std::invalid_argument("RgbdFrame: intrinsics fx=" + std::to_string(k.fx) +
-                                " fy=" + std::to_string(k.fy) + ": expected positive focal lengths");
+    throw std::invalid_argument("RgbdFrame: intrinsics fx=" + std::to_string(k.fx) + " fy=" +
+                                std::to_string(k.fy) + ": expected positive focal lengths");
   }
   const std::size_t n = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
   if (frame.depth.size() != n) {
@@ -77,7 +77,8 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
       }
       const Eigen::Vector3f pc((static_cast<float>(u) - cx) * inv_fx * z, yn * z, z);
       const Eigen::Vector3f pw = wRc * pc + wtc;
-      if (use_box && ((pw.array() < box_min.array()).any() || (pw.array() > box_max.array()).any())) {
+      if (use_box &&
+          ((pw.array() < box_min.array()).any() || (pw.array() > box_max.array()).any())) {
         continue;
       }
       if (use_sphere && (pw - centre).squaredNorm() > radius2) {

@@ -33,7 +33,8 @@ enum RecordType : std::uint32_t {
 };
 constexpr std::uint32_t kNodeTypeDepth = 2;
 constexpr std::uint32_t kNodeTypeImage = 3;
-constexpr std::uint32_t kCodecUncompressed = 'N' | ('O' << 8) | ('N' << 16) | (std::uint32_t{'E'} << 24);
+constexpr std::uint32_t kCodecUncompressed =
+    'N' | ('O' << 8) | ('N' << 16) | (std::uint32_t{'E'} << 24);
 constexpr std::uint32_t kXnPixelFormatRgb24 = 1;
 constexpr std::uint32_t kXnPixelFormatGray16 = 4;
 constexpr std::size_t kRecordHeaderBytes = 28;
@@ -41,7 +42,8 @@ constexpr std::size_t kRecordHeaderBytes = 28;
 /// One record being assembled: header, fields, payload.
 class Record {
  public:
-  Record(std::uint32_t type, std::uint32_t node, std::uint64_t undo) : bytes_(kRecordHeaderBytes, 0) {
+  Record(std::uint32_t type, std::uint32_t node, std::uint64_t undo)
+      : bytes_(kRecordHeaderBytes, 0) {
     put_at(0, std::uint32_t{0x0052494E});  // "NIR\0"
     put_at(4, type);
     put_at(8, node);
@@ -68,7 +70,8 @@ class Record {
   void write(std::ofstream& out, const void* payload = nullptr, std::size_t payload_bytes = 0) {
     put_at(12, static_cast<std::uint32_t>(bytes_.size()));
     put_at(16, static_cast<std::uint32_t>(payload_bytes));
-    out.write(reinterpret_cast<const char*>(bytes_.data()), static_cast<std::streamsize>(bytes_.size()));
+    out.write(reinterpret_cast<const char*>(bytes_.data()),
+              static_cast<std::streamsize>(bytes_.size()));
     if (payload_bytes > 0) {
       out.write(static_cast<const char*>(payload), static_cast<std::streamsize>(payload_bytes));
     }
@@ -101,7 +104,8 @@ void write_file_header(std::ofstream& out, std::uint32_t max_node_id) {
 
 OniWriter::OniWriter(const std::string& path, int fps) : path_(path), fps_(fps) {
   if (fps <= 0) {
-    throw std::invalid_argument("OniWriter " + path + ": fps " + std::to_string(fps) + ": expected > 0");
+    throw std::invalid_argument("OniWriter " + path + ": fps " + std::to_string(fps) +
+                                ": expected > 0");
   }
   out_.open(path, std::ios::binary | std::ios::trunc);
   if (!out_) {
@@ -160,7 +164,8 @@ void OniWriter::write_node_header(Node& node, bool depth, const CameraIntrinsics
   general_property("xnSupportedPixelFormats", &supported, sizeof supported);
   int_property("xnPixelFormat", xn_format);
   int_property("oniPixelFormat", depth ? ONI_PIXEL_FORMAT_DEPTH_1_MM : ONI_PIXEL_FORMAT_RGB888);
-  const double fov[2] = {2.0 * std::atan(0.5 * k.width / k.fx), 2.0 * std::atan(0.5 * k.height / k.fy)};
+  const double fov[2] = {2.0 * std::atan(0.5 * k.width / k.fx),
+                         2.0 * std::atan(0.5 * k.height / k.fy)};
   general_property("xnFOV", fov, sizeof fov);
   int_property("Cropping", 1);
 #pragma pack(push, 1)
@@ -196,7 +201,8 @@ void OniWriter::write(const RgbdFrame& frame) {
   }
   check_frame(frame);
   const CameraIntrinsics& k = frame.intrinsics;
-  const auto time_us = static_cast<std::uint64_t>(std::llround(std::max(0.0, frame.timestamp) * 1e6));
+  const auto time_us =
+      static_cast<std::uint64_t>(std::llround(std::max(0.0, frame.timestamp) * 1e6));
   if (count_ == 0) {
     intrinsics_ = k;
     has_colour_ = !frame.rgb.empty();
@@ -214,14 +220,15 @@ void OniWriter::write(const RgbdFrame& frame) {
     }
   } else {
     if (k.width != intrinsics_.width || k.height != intrinsics_.height) {
-      throw std::invalid_argument("OniWriter " + path_ + ": frame " + std::to_string(count_) +
-                                  " is " + std::to_string(k.width) + "x" + std::to_string(k.height) +
-                                  ", the recording " + std::to_string(intrinsics_.width) + "x" +
-                                  std::to_string(intrinsics_.height));
+      throw std::invalid_argument(
+          "OniWriter " + path_ + ": frame " + std::to_string(count_) + " is " +
+          std::to_string(k.width) + "x" + std::to_string(k.height) + ", the recording " +
+          std::to_string(intrinsics_.width) + "x" + std::to_string(intrinsics_.height));
     }
     if (frame.rgb.empty() == has_colour_) {
-      throw std::invalid_argument("OniWriter " + path_ + ": frame " + std::to_string(count_) +
-                                  (has_colour_ ? " has no colour" : " has colour, the first had none"));
+      throw std::invalid_argument(
+          "OniWriter " + path_ + ": frame " + std::to_string(count_) +
+          (has_colour_ ? " has no colour" : " has colour, the first had none"));
     }
     if (time_us < last_time_us_) {
       throw std::invalid_argument("OniWriter " + path_ + ": timestamps go backwards at frame " +
@@ -232,7 +239,8 @@ void OniWriter::write(const RgbdFrame& frame) {
   depth_buffer_.resize(frame.depth.size());
   for (std::size_t i = 0; i < frame.depth.size(); ++i) {
     const double mm = std::round(static_cast<double>(frame.depth[i]) * 1000.0);
-    depth_buffer_[i] = std::isfinite(mm) && mm > 0.0 && mm <= 65535.0 ? static_cast<std::uint16_t>(mm) : 0;
+    depth_buffer_[i] =
+        std::isfinite(mm) && mm > 0.0 && mm <= 65535.0 ? static_cast<std::uint16_t>(mm) : 0;
   }
   write_frame(depth_, relative, depth_buffer_.data(), depth_buffer_.size() * 2);
   if (has_colour_) {

@@ -60,8 +60,8 @@ struct OpenNi2Source::Impl {
   openni::VideoStream colour;
   bool has_colour = false;
   bool file = false;
-  int frames = 0;     // depth frames in a recording
-  int read = 0;       // depth frames read so far
+  int frames = 0;  // depth frames in a recording
+  int read = 0;    // depth frames read so far
   std::vector<StampedPose> poses;
   double first_timestamp = -1.0;
 
@@ -140,8 +140,9 @@ bool OpenNi2Source::is_file() const { return impl_->file; }
 int OpenNi2Source::number_of_frames() const { return impl_->frames; }
 
 std::string OpenNi2Source::describe() const {
-  return impl_->file ? "OpenNI2 recording " + uri_ + " (" + std::to_string(impl_->frames) + " frames)"
-                     : "OpenNI2 device " + uri_;
+  return impl_->file
+             ? "OpenNI2 recording " + uri_ + " (" + std::to_string(impl_->frames) + " frames)"
+             : "OpenNI2 device " + uri_;
 }
 
 namespace {
@@ -165,8 +166,8 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
   }
   openni::VideoFrameRef depth;
   if (!read_frame(s.depth, depth, options_.timeout_ms)) {
-    throw std::runtime_error(uri_ + ": no depth frame within " + std::to_string(options_.timeout_ms) +
-                             " ms: " + last_error());
+    throw std::runtime_error(uri_ + ": no depth frame within " +
+                             std::to_string(options_.timeout_ms) + " ms: " + last_error());
   }
   ++s.read;
   const openni::VideoMode mode = depth.getVideoMode();
@@ -186,8 +187,9 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
   if (options_.intrinsics) {
     f.intrinsics = *options_.intrinsics;
     if (f.intrinsics.width != w || f.intrinsics.height != h) {
-      throw std::runtime_error(uri_ + ": frames are " + std::to_string(w) + "x" + std::to_string(h) +
-                               ", the given intrinsics " + std::to_string(f.intrinsics.width) + "x" +
+      throw std::runtime_error(uri_ + ": frames are " + std::to_string(w) + "x" +
+                               std::to_string(h) + ", the given intrinsics " +
+                               std::to_string(f.intrinsics.width) + "x" +
                                std::to_string(f.intrinsics.height));
     }
   } else {
@@ -199,7 +201,8 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
     f.intrinsics.cy = 0.5 * h;
     if (!std::isfinite(f.intrinsics.fx) || !std::isfinite(f.intrinsics.fy) ||
         !(f.intrinsics.fx > 0.0) || !(f.intrinsics.fy > 0.0)) {
-      throw std::runtime_error(uri_ + ": the depth stream reports no usable field of view; "
+      throw std::runtime_error(uri_ +
+                               ": the depth stream reports no usable field of view; "
                                "give the intrinsics");
     }
   }
@@ -212,8 +215,8 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
   f.depth.resize(n);
   const auto* bytes = static_cast<const std::uint8_t*>(depth.getData());
   for (int v = 0; v < h; ++v) {
-    const auto* row = reinterpret_cast<const openni::DepthPixel*>(bytes + static_cast<std::size_t>(v) *
-                                                                              static_cast<std::size_t>(depth.getStrideInBytes()));
+    const auto* row = reinterpret_cast<const openni::DepthPixel*>(
+        bytes + static_cast<std::size_t>(v) * static_cast<std::size_t>(depth.getStrideInBytes()));
     for (int u = 0; u < w; ++u) {
       f.depth[f.index(u, v)] = static_cast<float>(row[u] * scale);
     }
@@ -225,8 +228,9 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
                                std::to_string(options_.timeout_ms) + " ms: " + last_error());
     }
     if (colour.getVideoMode().getPixelFormat() != openni::PIXEL_FORMAT_RGB888) {
-      throw std::runtime_error(uri_ + ": unsupported colour pixel format " +
-                               std::to_string(static_cast<int>(colour.getVideoMode().getPixelFormat())));
+      throw std::runtime_error(
+          uri_ + ": unsupported colour pixel format " +
+          std::to_string(static_cast<int>(colour.getVideoMode().getPixelFormat())));
     }
     const int cw = colour.getWidth();
     const int ch = colour.getHeight();
@@ -234,10 +238,12 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
     f.rgb.resize(3 * n);
     for (int v = 0; v < h; ++v) {
       const int cv = v * ch / h;  // nearest neighbour when the sizes differ
-      const std::uint8_t* row = cbytes + static_cast<std::size_t>(cv) * static_cast<std::size_t>(colour.getStrideInBytes());
+      const std::uint8_t* row = cbytes + static_cast<std::size_t>(cv) *
+                                             static_cast<std::size_t>(colour.getStrideInBytes());
       for (int u = 0; u < w; ++u) {
         const int cu = u * cw / w;
-        std::copy_n(row + 3 * cu, 3, f.rgb.begin() + static_cast<std::ptrdiff_t>(3 * f.index(u, v)));
+        std::copy_n(row + 3 * cu, 3,
+                    f.rgb.begin() + static_cast<std::ptrdiff_t>(3 * f.index(u, v)));
       }
     }
   }

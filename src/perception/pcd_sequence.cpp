@@ -104,7 +104,8 @@ std::optional<RgbdFrame> PcdSequenceSource::next() {
     throw std::runtime_error(path + ": cannot read the PCD file");
   }
   if (!cloud.isOrganized()) {
-    throw std::runtime_error(path + ": the cloud is not organised (height 1); an RGB-D frame needs rows");
+    throw std::runtime_error(path +
+                             ": the cloud is not organised (height 1); an RGB-D frame needs rows");
   }
   if (!intrinsics_) {
     intrinsics_ = fit_intrinsics(cloud);

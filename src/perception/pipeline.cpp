@@ -16,19 +16,26 @@ namespace ofv {
 
 const char* to_string(TrackingStatus status) {
   switch (status) {
-    case TrackingStatus::Initialised: return "initialised";
-    case TrackingStatus::Tracking: return "tracking";
-    case TrackingStatus::Lost: return "lost";
+    case TrackingStatus::Initialised:
+      return "initialised";
+    case TrackingStatus::Tracking:
+      return "tracking";
+    case TrackingStatus::Lost:
+      return "lost";
   }
   return "?";
 }
 
 const char* to_string(SupervoxelClass label) {
   switch (label) {
-    case SupervoxelClass::Object: return "object";
-    case SupervoxelClass::Interacting: return "interacting";
-    case SupervoxelClass::Occluder: return "occluder";
-    case SupervoxelClass::Background: return "background";
+    case SupervoxelClass::Object:
+      return "object";
+    case SupervoxelClass::Interacting:
+      return "interacting";
+    case SupervoxelClass::Occluder:
+      return "occluder";
+    case SupervoxelClass::Background:
+      return "background";
   }
   return "?";
 }
@@ -70,7 +77,8 @@ class PointGrid {
     const float r2 = radius * radius;
     bool found = false;
     for_each_near(p, [&](int j) {
-      found = found || (((*points_)[static_cast<std::size_t>(j)] - p).squaredNorm() <= r2 && accept(j));
+      found =
+          found || (((*points_)[static_cast<std::size_t>(j)] - p).squaredNorm() <= r2 && accept(j));
     });
     return found;
   }
@@ -83,8 +91,9 @@ class PointGrid {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const std::uint64_t k = key(c + Eigen::Vector3i(dx, dy, dz));
-          auto it = std::lower_bound(entries_.begin(), entries_.end(), k,
-                                     [](const Entry& e, std::uint64_t value) { return e.key < value; });
+          auto it =
+              std::lower_bound(entries_.begin(), entries_.end(), k,
+                               [](const Entry& e, std::uint64_t value) { return e.key < value; });
           for (; it != entries_.end() && it->key == k; ++it) {
             f(it->index);
           }
@@ -128,12 +137,11 @@ std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eigen::Isom
 }
 
 /// Colour without brightness: R, G, B over their sum (shading-invariant).
-Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) {
-  return rgb / std::max(rgb.sum(), 1.0f);
-}
+Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) { return rgb / std::max(rgb.sum(), 1.0f); }
 
 /// Connected components of the vertices with keep[i], over `edges`.
-std::vector<std::vector<int>> components(std::size_t n, const std::vector<std::pair<int, int>>& edges,
+std::vector<std::vector<int>> components(std::size_t n,
+                                         const std::vector<std::pair<int, int>>& edges,
                                          const std::vector<char>& keep) {
   std::vector<int> parent(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -141,7 +149,8 @@ std::vector<std::vector<int>> components(std::size_t n, const std::vector<std::p
   }
   const auto find = [&parent](int i) {
     while (parent[static_cast<std::size_t>(i)] != i) {
-      parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      parent[static_cast<std::size_t>(i)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
       i = parent[static_cast<std::size_t>(i)];
     }
     return i;
@@ -224,7 +233,7 @@ struct Perception::Impl {
   CloudBuilder builder;
   WorldCloud cloud;
   detail::SupervoxelOutput sv;
-  PointGrid grid;          // reused for adjacency and tracking
+  PointGrid grid;  // reused for adjacency and tracking
   std::vector<Eigen::Vector3f> centroids;
 
   // Object state carried from frame to frame (world frame).
@@ -232,9 +241,9 @@ struct Perception::Impl {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3f> memory;  // object voxels: seen now, or hidden behind something
   std::vector<Eigen::Vector3f> memory_chroma;  // chromaticity of each memory voxel
-  std::vector<int> memory_age;          // frames since the voxel was last seen
-  std::size_t initial_voxels = 0;       // object voxels in the first frame (seen whole)
-  std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
+  std::vector<int> memory_age;                 // frames since the voxel was last seen
+  std::size_t initial_voxels = 0;              // object voxels in the first frame (seen whole)
+  std::optional<Eigen::Vector4d> plane;        // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
 
   /// True for a voxel of the support plane: on it, and of its colour.
@@ -258,8 +267,9 @@ struct Perception::Impl {
   /// straddle the foot and the plane have normals in between and go with
   /// the plane.
   [[nodiscard]] bool on_plane(const SupervoxelInfo& s) const {
-    return plane && std::abs(plane->head<3>().dot(s.centroid) + (*plane)(3)) <=
-                        settings.tracking.plane_distance &&
+    return plane &&
+           std::abs(plane->head<3>().dot(s.centroid) + (*plane)(3)) <=
+               settings.tracking.plane_distance &&
            std::abs(plane->head<3>().dot(s.normal)) >= std::cos(M_PI / 3.0);
   }
 
@@ -406,7 +416,8 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
   switch (sel.mode) {
     case ObjectSelection::Mode::Box:
       for (std::size_t i = 0; i < n; ++i) {
-        object[i] = sel.box.contains(r.supervoxels[i].centroid) && !on_plane(r.supervoxels[i]) ? 1 : 0;
+        object[i] =
+            sel.box.contains(r.supervoxels[i].centroid) && !on_plane(r.supervoxels[i]) ? 1 : 0;
       }
       if (std::none_of(object.begin(), object.end(), [](char c) { return c != 0; })) {
         why = "no supervoxel inside the selection box";
@@ -487,22 +498,23 @@ std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     const Eigen::Vector3f c = chroma(sv.colours[i]);
-    const bool is_near = !plane_voxel(r.voxels[i], sv.colours[i]) &&
-                         grid.any_within(r.voxels[i], radius, [&](int j) {
-                           return max_chroma <= 0.0f ||
-                                  (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <=
-                                      max_chroma;
-                         });
+    const bool is_near =
+        !plane_voxel(r.voxels[i], sv.colours[i]) &&
+        grid.any_within(r.voxels[i], radius, [&](int j) {
+          return max_chroma <= 0.0f ||
+                 (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
+        });
     near[owner] += is_near ? 1 : 0;
     voxel_matched[i] = is_near ? 1 : 0;
   }
   std::vector<char> object(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    object[i] = static_cast<double>(near[i]) >=
-                            t.min_near_fraction * static_cast<double>(r.supervoxels[i].voxel_count) &&
-                        !on_plane(r.supervoxels[i])
-                    ? 1
-                    : 0;
+    object[i] =
+        static_cast<double>(near[i]) >=
+                    t.min_near_fraction * static_cast<double>(r.supervoxels[i].voxel_count) &&
+                !on_plane(r.supervoxels[i])
+            ? 1
+            : 0;
   }
   return object;
 }

@@ -36,7 +36,8 @@ std::vector<StampedPose> read_pose_file(const std::string& path) {
     }
     const Eigen::Quaterniond q(qw, qx, qy, qz);
     if (!(q.norm() > 1e-6) || !std::isfinite(q.norm()) || !std::isfinite(tx + ty + tz + t)) {
-      throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose '" + line + "'");
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose '" + line +
+                               "'");
     }
     StampedPose p;
     p.time = t;

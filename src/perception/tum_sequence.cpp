@@ -54,7 +54,8 @@ std::vector<ListEntry> read_list(const std::string& path) {
 
 }  // namespace
 
-TumSequenceSource::TumSequenceSource(const std::string& directory, const TumSequenceOptions& options)
+TumSequenceSource::TumSequenceSource(const std::string& directory,
+                                     const TumSequenceOptions& options)
     : directory_(directory), options_(options) {
   if (!fs::is_directory(directory)) {
     throw std::runtime_error(directory + ": not a directory (expected a TUM RGB-D sequence)");
@@ -208,7 +209,8 @@ void TumSequenceWriter::write(const RgbdFrame& frame) {
     }
     std::ofstream(dir / "rgb.txt", std::ios::app) << stamp << ' ' << rgb_name << '\n';
   }
-  std::ofstream(dir / "groundtruth.txt", std::ios::app) << format_pose_line(frame.timestamp, frame.wMc);
+  std::ofstream(dir / "groundtruth.txt", std::ios::app)
+      << format_pose_line(frame.timestamp, frame.wMc);
   ++count_;
 }
 

@@ -23,9 +23,9 @@ struct Shape {
   enum class Kind { Box, Capsule } kind = Kind::Box;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // box centre/orientation
   Eigen::Vector3d half = Eigen::Vector3d::Constant(0.05);  // box half extents [m]
-  Eigen::Vector3d a = Eigen::Vector3d::Zero();              // capsule ends [m]
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();             // capsule ends [m]
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  double radius = 0.02;                                     // capsule radius [m]
+  double radius = 0.02;  // capsule radius [m]
   Eigen::Vector3d colour{200, 200, 200};
   int label = kOther;
 };

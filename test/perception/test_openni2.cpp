@@ -21,9 +21,9 @@ std::vector<RgbdFrame> moving_case(int frames) {
     const Eigen::Vector3d centre(0.01 * k, 0.0, 0.0675);
     const test::SyntheticScene scene = test::table_and_case(centre);
     const Eigen::Vector3d target(0.0, 0.0, 0.0675);
-    out.push_back(scene.render(test::vga(320),
-                               test::look_at(target + Eigen::Vector3d(0.01 * k, -0.45, 0.22), target),
-                               nullptr, k / 30.0));
+    out.push_back(scene.render(
+        test::vga(320), test::look_at(target + Eigen::Vector3d(0.01 * k, -0.45, 0.22), target),
+        nullptr, k / 30.0));
   }
   return out;
 }
@@ -97,7 +97,8 @@ TEST(OpenNi2, WriterRejectsInconsistentFrames) {
   other.rgb.clear();
   other.timestamp += 0.1;
   EXPECT_THROW(writer.write(other), std::invalid_argument);
-  RgbdFrame bigger = test::table_and_case().render(test::vga(640), test::front_camera(), nullptr, 1.0);
+  RgbdFrame bigger =
+      test::table_and_case().render(test::vga(640), test::front_camera(), nullptr, 1.0);
   EXPECT_THROW(writer.write(bigger), std::invalid_argument);
 }
 

@@ -57,8 +57,8 @@ std::vector<RgbdFrame> episode() {
                                                 skin, test::kHand));
     }
     if (k >= 2) {
-      scene.shapes.push_back(test::make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025,
-                                                skin, test::kHand));
+      scene.shapes.push_back(
+          test::make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025, skin, test::kHand));
     }
     frames.push_back(scene.render(test::vga(320), test::front_camera(), nullptr, k / 30.0));
   }

@@ -62,7 +62,8 @@ TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
   EXPECT_NEAR(r.axes.determinant(), 1.0, 1e-9);
   // The augmented OBB holds every object voxel.
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    if (r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == SupervoxelClass::Object) {
+    if (r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label ==
+        SupervoxelClass::Object) {
       ASSERT_TRUE(r.obb.contains(r.voxels[i].cast<double>()));
     }
   }
@@ -159,9 +160,11 @@ TEST(Perception, FollowsAMovingDeformingObject) {
     // Slides 6 mm per frame to the right and stretches 1 % per frame.
     test::SyntheticScene scene;
     const Eigen::Vector3d centre = kCaseCentre + Eigen::Vector3d(0.006 * k, 0.0, 0.0);
-    scene.shapes.push_back(test::make_box({0.0, 0.0, -0.02}, {1.6, 1.6, 0.04}, {150, 110, 70}, kTable));
+    scene.shapes.push_back(
+        test::make_box({0.0, 0.0, -0.02}, {1.6, 1.6, 0.04}, {150, 110, 70}, kTable));
     const double stretch = 1.0 + 0.01 * k;
-    scene.shapes.push_back(test::make_box(centre, {0.19 * stretch, 0.015, 0.135}, {40, 60, 200}, kObject));
+    scene.shapes.push_back(
+        test::make_box(centre, {0.19 * stretch, 0.015, 0.135}, {40, 60, 200}, kObject));
     scene.shapes.push_back(holding_hand(0.0));
     scene.shapes.back().a += Eigen::Vector3d(0.006 * k + 0.095 * (stretch - 1.0), 0.0, 0.0);
     scene.shapes.back().b += Eigen::Vector3d(0.006 * k + 0.095 * (stretch - 1.0), 0.0, 0.0);
@@ -263,13 +266,14 @@ TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
 TEST(Perception, BoxAndImageSelectionsPickTheCase) {
   const Eigen::Isometry3d wMc = test::front_camera();
   test::SyntheticScene scene = test::table_and_case();
-  scene.shapes.push_back(test::make_box({0.3, 0.1, 0.05}, {0.1, 0.1, 0.1}, {200, 30, 30}, test::kOther));
+  scene.shapes.push_back(
+      test::make_box({0.3, 0.1, 0.05}, {0.1, 0.1, 0.1}, {200, 30, 30}, test::kOther));
   const Frame f = render(scene, wMc);
 
   PerceptionSettings by_box;
   by_box.selection.mode = ObjectSelection::Mode::Box;
-  by_box.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.12, -0.03, 0.005),
-                                             Eigen::Vector3d(0.12, 0.03, 0.16));
+  by_box.selection.box =
+      Eigen::AlignedBox3d(Eigen::Vector3d(-0.12, -0.03, 0.005), Eigen::Vector3d(0.12, 0.03, 0.16));
   PerceptionSettings by_rect;
   by_rect.selection.mode = ObjectSelection::Mode::Image;
   // The case's front face, projected: pixels of the ground truth's bounding box.
@@ -307,7 +311,8 @@ TEST(Perception, BoxAndImageSelectionsPickTheCase) {
 
 TEST(Perception, ResultMovesWithARigidMotionOfTheWholeWorld) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, -0.4, 1.0).normalized()).toRotationMatrix();
+  T.linear() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, -0.4, 1.0).normalized()).toRotationMatrix();
   T.translation() = Eigen::Vector3d(1.5, -0.7, 0.4);
   test::SyntheticScene scene = test::table_and_case();
   test::SyntheticScene moved = scene;

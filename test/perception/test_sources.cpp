@@ -28,7 +28,8 @@ std::vector<RgbdFrame> episode(int frames, int width = 320) {
   std::vector<RgbdFrame> out;
   for (int k = 0; k < frames; ++k) {
     const Eigen::Vector3d target(0.0, 0.0, 0.0675);
-    const Eigen::Isometry3d wMc = test::look_at(target + Eigen::Vector3d(0.02 * k, -0.45, 0.22), target);
+    const Eigen::Isometry3d wMc =
+        test::look_at(target + Eigen::Vector3d(0.02 * k, -0.45, 0.22), target);
     out.push_back(scene.render(test::vga(width), wMc, nullptr, 0.1 * k));
   }
   return out;
@@ -83,7 +84,8 @@ TEST(TumSequence, AssociatesNearestColourAndInterpolatesPoses) {
   // first colour entry (its depth frame then has no colour); ground truth at
   // t = 0 and 0.1 only, so the pose at 0.105 is the last one.
   {
-    std::ofstream(dir / "depth.txt") << "# x\n0.000000 depth/0.000000.png\n0.105000 depth/0.100000.png\n";
+    std::ofstream(dir / "depth.txt")
+        << "# x\n0.000000 depth/0.000000.png\n0.105000 depth/0.100000.png\n";
     std::ofstream(dir / "rgb.txt") << "0.100000 rgb/0.100000.png\n";
   }
   TumSequenceSource source(dir.string());

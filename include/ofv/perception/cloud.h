@@ -43,10 +43,10 @@ struct CloudSettings {
  *        (voxel mean of position and colour).
  */
 struct WorldCloud {
-  std::vector<Eigen::Vector3f> points;     ///< world frame [m]
-  std::vector<Eigen::Vector3f> colours;    ///< R, G, B in [0, 255]
-  std::size_t valid_pixels = 0;            ///< pixels with finite, positive depth (after stride)
-  std::size_t cropped_points = 0;          ///< of those, inside the crop volume
+  std::vector<Eigen::Vector3f> points;   ///< world frame [m]
+  std::vector<Eigen::Vector3f> colours;  ///< R, G, B in [0, 255]
+  std::size_t valid_pixels = 0;          ///< pixels with finite, positive depth (after stride)
+  std::size_t cropped_points = 0;        ///< of those, inside the crop volume
 
   void clear() {
     points.clear();

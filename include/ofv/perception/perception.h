@@ -92,19 +92,19 @@ struct ObjectSelection {
     Image,  ///< supervoxels whose centroid projects inside `rect` or onto a non-zero `mask` pixel
   };
   Mode mode = Mode::Auto;
-  Eigen::AlignedBox3d box;        ///< world frame [m], for Mode::Box (also the first crop)
-  Eigen::AlignedBox2i rect;       ///< pixels [u0, v0] .. [u1, v1] inclusive, for Mode::Image
-  std::vector<std::uint8_t> mask; ///< width x height, non-zero = object; overrides `rect`
+  Eigen::AlignedBox3d box;         ///< world frame [m], for Mode::Box (also the first crop)
+  Eigen::AlignedBox2i rect;        ///< pixels [u0, v0] .. [u1, v1] inclusive, for Mode::Image
+  std::vector<std::uint8_t> mask;  ///< width x height, non-zero = object; overrides `rect`
 };
 
 /// \brief All settings of the front end.
 struct PerceptionSettings {
-  CloudSettings cloud;             ///< back-projection; its voxel resolution is supervoxels.voxel_resolution
+  CloudSettings cloud;  ///< back-projection; its voxel resolution is supervoxels.voxel_resolution
   SupervoxelSettings supervoxels;
   TrackingSettings tracking;
-  double r_sphere = 0.5;           ///< R_sphere = d_pref (paper eq. 2) [m]
-  double crop_margin = 0.1;        ///< crop radius = r_sphere + crop_margin around the previous C [m]
-  double max_depth = 3.0;          ///< points farther along the optical axis are dropped [m]
+  double r_sphere = 0.5;     ///< R_sphere = d_pref (paper eq. 2) [m]
+  double crop_margin = 0.1;  ///< crop radius = r_sphere + crop_margin around the previous C [m]
+  double max_depth = 3.0;    ///< points farther along the optical axis are dropped [m]
   /// The object's OBB (PCA of its voxels) grows by this on every side [m]:
   /// what lies inside it but is not object is interacting (a holding hand).
   double obb_margin = 0.03;
@@ -149,7 +149,7 @@ struct PerceptionCounts {
   std::size_t cropped_points = 0;  ///< inside the working volume
   std::size_t voxels = 0;          ///< occupied voxels given to the supervoxel stage
   std::size_t supervoxels = 0;
-  std::size_t adjacency_edges = 0; ///< pairs within R_adj
+  std::size_t adjacency_edges = 0;  ///< pairs within R_adj
   std::size_t object = 0;
   std::size_t interacting = 0;
   std::size_t occluders = 0;
@@ -177,8 +177,9 @@ struct PerceptionResult {
   std::vector<Eigen::Vector3f> voxels;                 ///< every clustered voxel
   std::vector<int> voxel_owner;                        ///< its supervoxel index
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< C: mean of the object voxels
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< e1, e2, e3 (columns), PCA of the object voxels
-  OrientedBox obb;                                     ///< the augmented OBB
+  Eigen::Matrix3d axes =
+      Eigen::Matrix3d::Identity();  ///< e1, e2, e3 (columns), PCA of the object voxels
+  OrientedBox obb;                  ///< the augmented OBB
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< pose of the camera that saw the frame
   PerceptionCounts counts;
   PerceptionTimings timings;

@@ -31,9 +31,9 @@ struct OpenNi2Options {
   /// Recordings only: 1 = real time, 2 = twice as fast, 0 = as fast as
   /// possible, -1 = one frame each time next() asks (no frame is skipped).
   float playback_speed = -1.0f;
-  int timeout_ms = 3000;  ///< longest wait for a frame [ms]
+  int timeout_ms = 3000;                       ///< longest wait for a frame [ms]
   std::optional<CameraIntrinsics> intrinsics;  ///< overrides the fields of view
-  bool colour = true;  ///< also read the colour stream when there is one
+  bool colour = true;                          ///< also read the colour stream when there is one
 };
 
 /**

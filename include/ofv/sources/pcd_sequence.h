@@ -46,7 +46,8 @@ class PcdSequenceWriter {
  public:
   /// \throws std::runtime_error naming the directory when it cannot be created.
   explicit PcdSequenceWriter(const std::string& directory);
-  /// \throws std::invalid_argument for inconsistent buffers; std::runtime_error when a file cannot be written.
+  /// \throws std::invalid_argument for inconsistent buffers; std::runtime_error when a file cannot
+  /// be written.
   void write(const RgbdFrame& frame);
   [[nodiscard]] std::size_t count() const { return count_; }
 

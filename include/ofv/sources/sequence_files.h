@@ -38,7 +38,8 @@ struct StampedPose {
  *        bracketing poses, the nearest end pose outside their range.
  * \pre poses sorted by time and not empty.
  */
-[[nodiscard]] Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double time);
+[[nodiscard]] Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses,
+                                                 double time);
 
 /**
  * \brief Reads `width height fx fy cx cy` (one line, `#` comments) [px].

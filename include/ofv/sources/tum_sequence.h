@@ -23,8 +23,8 @@ namespace ofv {
 
 /// \brief Options of TumSequenceSource.
 struct TumSequenceOptions {
-  double depth_factor = 5000.0;        ///< PNG value per metre (TUM: 5000)
-  double max_time_difference = 0.02;   ///< largest rgb/depth timestamp gap when associating [s]
+  double depth_factor = 5000.0;       ///< PNG value per metre (TUM: 5000)
+  double max_time_difference = 0.02;  ///< largest rgb/depth timestamp gap when associating [s]
   std::optional<CameraIntrinsics> intrinsics;  ///< overrides intrinsics.txt and the default
 };
 
@@ -38,10 +38,12 @@ struct TumSequenceOptions {
  */
 class TumSequenceSource : public FrameSource {
  public:
-  /// \throws std::runtime_error naming the path when the directory or its lists are missing or broken.
+  /// \throws std::runtime_error naming the path when the directory or its lists are missing or
+  /// broken.
   explicit TumSequenceSource(const std::string& directory, const TumSequenceOptions& options = {});
 
-  /// \throws std::runtime_error naming the file when an image is missing, unreadable or of the wrong size.
+  /// \throws std::runtime_error naming the file when an image is missing, unreadable or of the
+  /// wrong size.
   std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::string describe() const override;
   /// Number of frames in the sequence.
