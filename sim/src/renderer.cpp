@@ -82,7 +82,7 @@ void grid_cells(const std::vector<WorldPoint>& pts, double cell, Eigen::Matrix3X
     const std::array<long, 3> key{static_cast<long>(std::floor(w.p.x() / cell)),
                                   static_cast<long>(std::floor(w.p.y() / cell)),
                                   static_cast<long>(std::floor(w.p.z() / cell))};
-    auto& c = cells[key];
+    auto& c = cells.try_emplace(key, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()).first->second;
     c.first += w.p;
     c.second += w.n;
     ++counts[key];

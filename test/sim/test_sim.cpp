@@ -1,0 +1,255 @@
+// The simulated world: scenario files, motion, deformation, rendering against
+// analytic depth, labels, ground-truth visibility, determinism.
+#include "ofv/sim/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace ofv::sim {
+namespace {
+
+constexpr const char* kSource = "test.yaml";
+
+std::string error_of(const std::string& yaml) {
+  try {
+    (void)scenario_from_yaml(yaml, kSource);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// A flat wall (thin box) facing the camera at depth `z`, and optional extra YAML.
+Scenario wall_scene(double z, const std::string& extra = "") {
+  return scenario_from_yaml(
+      "sensor: {noise: {enabled: false}}\n"
+      "object: {shape: box, size: [0.2, 0.2, 0.01], position: [0, 0, " + std::to_string(z) + "]}\n" + extra,
+      kSource);
+}
+
+TEST(Scenario, DefaultsOfAMinimalFile) {
+  const Scenario s = scenario_from_yaml("object: {shape: box}", kSource);
+  EXPECT_EQ(s.duration, 4.0);
+  EXPECT_EQ(s.rate, 30.0);
+  EXPECT_EQ(s.sensor.intrinsics.width, 320);
+  EXPECT_EQ(s.sensor.min_depth, 0.1);
+  EXPECT_EQ(s.sensor.max_depth, 3.0);
+  EXPECT_TRUE(s.sensor.noise.enabled);
+  EXPECT_EQ(s.robot, "camera");
+  EXPECT_TRUE(s.wMc_start.isApprox(Eigen::Isometry3d::Identity()));  // looks along +z, y down
+  ASSERT_EQ(s.bodies.size(), 1U);
+  EXPECT_EQ(s.bodies[0].role, Role::Object);
+  EXPECT_NEAR(s.bodies[0].mesh.area(), 2 * (0.19 * 0.135 + 0.19 * 0.015 + 0.135 * 0.015), 1e-6);
+  EXPECT_EQ(s.r_sphere(), 0.5);
+}
+
+TEST(Scenario, ErrorsNameFileKeyAndValue) {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases{
+      {"duration: 2", {"missing 'object'"}},
+      {"object: {shape: cone}", {"object.shape", "cone"}},
+      {"object: {shape: box, colr: [1, 2, 3]}", {"object.colr", "unknown key"}},
+      {"object: {shape: box}\nspeed: 3", {"speed", "unknown key"}},
+      {"object: {shape: box}\nduration: -1", {"duration", "-1"}},
+      {"object: {shape: box}\nrate: fast", {"rate", "fast"}},
+      {"object: {shape: box, colour: [300, 0, 0]}", {"object.colour", "300"}},
+      {"object: {shape: box, size: [1, 2]}", {"object.size"}},
+      {"object: {shape: box, waypoints: [{t: 1}, {t: 0.5}]}", {"object.waypoints[1].t", "increase"}},
+      {"object: {shape: mesh}", {"object", "file"}},
+      {"object: {shape: mesh, file: /nonexistent.obj}", {"object.file", "nonexistent.obj"}},
+      {"object: {shape: box}\nsensor: {preset: kinect}", {"sensor.preset", "kinect"}},
+      {"object: {shape: box}\nsensor: {noise: {edge_dropout: 2}}", {"sensor.noise.edge_dropout", "2"}},
+      {"object: {shape: box}\nestimator: {step: -1}", {"estimator", "step", "-1"}},
+      {"object: {shape: box}\nestimator: {speed: 1}", {"estimator.speed", "unknown parameter"}},
+      {"object: {shape: box}\nrobot: puma", {"robot", "puma"}},
+      {"object: {shape: box}\ncamera: {position: [0, 0, 0], look_at: [0, 0, 0]}", {"camera"}},
+      {"object: {shape: box, wave: {amplitude: 0.1}}", {"object.wave", "cloth"}},
+      {"object: [1, 2", {"invalid YAML"}},
+  };
+  for (const auto& [yaml, mentions] : cases) {
+    const std::string message = error_of(yaml);
+    EXPECT_NE(message.find(kSource), std::string::npos) << yaml << " -> " << message;
+    for (const auto& m : mentions) EXPECT_NE(message.find(m), std::string::npos) << yaml << " -> " << message;
+  }
+}
+
+TEST(Scenario, BuiltInScenariosLoad) {
+  const auto names = builtin_scenarios();
+  for (const char* expected : {"dvd-static", "dvd-one-hand", "dvd-two-hands", "cloth-occluder",
+                               "sweep", "moving-object", "no-free-view"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+  }
+  for (const auto& n : names) {
+    const Scenario s = load_scenario(n);
+    EXPECT_EQ(s.name, n);
+    for (const auto& b : s.bodies) EXPECT_TRUE(b.mesh.valid()) << n << " " << b.name;
+  }
+  EXPECT_THROW((void)load_scenario("no-such-scenario"), std::invalid_argument);
+}
+
+TEST(Motion, InterpolatesPositionLinearlyAndRotationBySlerp) {
+  Motion m;
+  Waypoint a, b;
+  a.t = 1.0;
+  a.position = {0, 0, 0};
+  b.t = 3.0;
+  b.position = {2, 0, 0};
+  b.rpy_deg = {0, 0, 90};
+  m.waypoints = {a, b};
+  EXPECT_TRUE(m.at(0.0).translation().isApprox(Eigen::Vector3d::Zero()));  // held before
+  EXPECT_TRUE(m.at(2.0).translation().isApprox(Eigen::Vector3d(1, 0, 0)));
+  EXPECT_NEAR(Eigen::AngleAxisd(m.at(2.0).linear()).angle(), 3.14159265358979 / 4, 1e-9);
+  EXPECT_TRUE(m.at(9.0).translation().isApprox(Eigen::Vector3d(2, 0, 0)));  // held after
+}
+
+TEST(Mesh, PrimitivesAreValidAndClosedWithOutwardNormals) {
+  for (const TriangleMesh& m : {make_box({0.1, 0.2, 0.3}), make_sphere(0.1), make_capsule(0.05, 0.2),
+                                make_sheet(0.3, 0.2, 0.002, 6, 4)}) {
+    ASSERT_TRUE(m.valid());
+    // Divergence theorem: the signed volume is positive iff normals point out.
+    double volume = 0.0;
+    for (const auto& t : m.triangles) {
+      volume += m.vertices[t[0]].cast<double>().dot(m.vertices[t[1]].cast<double>().cross(m.vertices[t[2]].cast<double>())) / 6.0;
+    }
+    EXPECT_GT(volume, 0.0);
+  }
+  EXPECT_NEAR(make_box({0.1, 0.2, 0.3}).area(), 2 * (0.02 + 0.03 + 0.06), 1e-6);
+  EXPECT_NEAR(make_sphere(0.1, 64, 32).area(), 4 * 3.14159265 * 0.01, 2e-3);
+}
+
+TEST(Mesh, DeformationKeepsTheSheetValid) {
+  const TriangleMesh rest = make_sheet(0.3, 0.2, 0.004, 20, 10);
+  TriangleMesh bent;
+  for (double t : {0.0, 0.3, 1.7}) {
+    deform_sheet(rest, 0.02, 0.15, 0.5, 1.0, t, bent);
+    ASSERT_TRUE(bent.valid());
+    EXPECT_EQ(bent.triangles, rest.triangles);
+    // Both faces move together: the thickness is kept.
+    const std::size_t per_face = rest.vertices.size() / 2;
+    EXPECT_NEAR((bent.vertices[per_face + 7] - bent.vertices[7]).norm(), 0.004, 1e-6);
+  }
+  deform_sheet(rest, 0.02, 0.15, 0.5, 0.0, 0.0, bent);
+  EXPECT_FALSE(bent.vertices[3].isApprox(rest.vertices[3]));
+}
+
+TEST(Renderer, DepthOfAPlaneMatchesTheAnalyticValue) {
+  const Scenario s = scenario_from_yaml(
+      "sensor: {noise: {enabled: false}}\nobject: {shape: box, size: [1, 1, 0.01], position: [0, 0, 1]}", kSource);
+  Renderer r(s);
+  // Straight on: every pixel on the wall sees its front face at z = 0.995.
+  RenderedFrame f = r.render(s.wMc_start, 0);
+  const CameraIntrinsics& k = f.frame.intrinsics;
+  EXPECT_NEAR(f.frame.depth[f.frame.index(160, 120)], 0.995, 1e-5);
+  EXPECT_NEAR(f.frame.depth[f.frame.index(170, 130)], 0.995, 1e-5);
+  // Tilted camera about x by 5 degrees: depth along each ray is analytic.
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+  wMc.linear() = Eigen::AngleAxisd(5.0 * 3.14159265358979 / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  f = r.render(wMc, 0);
+  for (const auto& [u, v] : {std::pair{160, 120}, std::pair{150, 100}, std::pair{170, 140}}) {
+    const Eigen::Vector3d ray_w = wMc.linear() * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+    const double expected = 0.995 / ray_w.z();  // Z of the hit along a unit-Z camera ray
+    EXPECT_NEAR(f.frame.depth[f.frame.index(u, v)], expected, 1e-5) << u << "," << v;
+  }
+}
+
+TEST(Renderer, DepthOfASphereMatchesTheAnalyticValue) {
+  const Scenario s = scenario_from_yaml(
+      "sensor: {noise: {enabled: false}}\nobject: {shape: sphere, radius: 0.1, position: [0, 0, 0.8]}", kSource);
+  Renderer r(s);
+  const RenderedFrame f = r.render(s.wMc_start, 0);
+  const CameraIntrinsics& k = f.frame.intrinsics;
+  EXPECT_NEAR(f.frame.depth[f.frame.index(160, 120)], 0.7, 1e-3);  // tessellation tolerance
+  // Silhouette radius: tan(asin(r / d)) f.
+  const double radius_px = std::tan(std::asin(0.1 / 0.8)) * k.fx;
+  EXPECT_GT(f.frame.depth[f.frame.index(160 + static_cast<int>(radius_px) - 3, 120)], 0.0f);
+  EXPECT_EQ(f.frame.depth[f.frame.index(160 + static_cast<int>(radius_px) + 3, 120)], 0.0f);
+  // Off-centre pixel inside: analytic ray-sphere hit, Z component.
+  const Eigen::Vector3d d((180 - k.cx) / k.fx, (130 - k.cy) / k.fy, 1.0);
+  const Eigen::Vector3d c(0, 0, 0.8);
+  const double b = d.dot(c), a = d.squaredNorm();
+  const double t = (b - std::sqrt(b * b - a * (c.squaredNorm() - 0.01))) / a;
+  EXPECT_NEAR(f.frame.depth[f.frame.index(180, 130)], t, 2e-3);
+}
+
+TEST(Renderer, LabelsNameWhatEachPixelSees) {
+  const Scenario s = wall_scene(1.0,
+      "occluders: [{shape: box, size: [0.05, 0.05, 0.05], position: [0, 0, 0.5]}]\n"
+      "holder: {shape: sphere, radius: 0.02, position: [0.12, 0, 1.0]}\n"
+      "table: {position: [0, 0.3, 1.0], size: [2, 0.02, 2]}\n");
+  Renderer r(s);
+  const RenderedFrame f = r.render(s.wMc_start, 0);
+  const CameraIntrinsics& k = f.frame.intrinsics;
+  auto label_at = [&](const Eigen::Vector3d& p) {
+    const int u = static_cast<int>(std::lround(k.fx * p.x() / p.z() + k.cx));
+    const int v = static_cast<int>(std::lround(k.fy * p.y() / p.z() + k.cy));
+    return f.labels[f.frame.index(u, v)];
+  };
+  EXPECT_EQ(label_at({0, 0, 0.5}), kLabelOccluder0);
+  EXPECT_EQ(label_at({0.07, 0.05, 1.0}), kLabelObject);
+  EXPECT_EQ(label_at({0.125, 0.0, 1.0}), kLabelInteracting);
+  EXPECT_EQ(label_at({0.0, 0.29, 1.2}), kLabelBackground);
+  EXPECT_EQ(f.labels[f.frame.index(2, 2)], kLabelNone);
+  EXPECT_EQ(f.frame.depth[f.frame.index(2, 2)], 0.0f);
+}
+
+TEST(Truth, VisibleFractionOnHandComputedCases) {
+  const double r_sphere = 0.5;
+  {  // fully visible
+    Renderer r(wall_scene(0.6));
+    EXPECT_NEAR(r.truth(r.scenario().wMc_start, r_sphere).visible_fraction, 1.0, 1e-9);
+  }
+  {  // the left half covered by a box half-way between camera and wall: [-0.05, 0] at 0.3 m
+  // covers [-0.1, 0] at 0.6 m (only the front face faces the camera)
+    Renderer r(wall_scene(0.6, "occluders: [{shape: box, size: [0.05, 0.3, 0.02], position: [-0.025, 0, 0.3]}]"));
+    const ObjectTruth t = r.truth(r.scenario().wMc_start, r_sphere);
+    EXPECT_NEAR(t.visible_fraction, 0.5, 0.05);
+    EXPECT_EQ(t.occluders_in_sphere, 1);
+  }
+  {  // fully covered
+    Renderer r(wall_scene(0.6, "occluders: [{shape: box, size: [0.4, 0.4, 0.02], position: [0, 0, 0.3]}]"));
+    EXPECT_EQ(r.truth(r.scenario().wMc_start, r_sphere).visible_fraction, 0.0);
+  }
+  {  // behind the camera
+    Renderer r(wall_scene(-0.6));
+    EXPECT_EQ(r.truth(r.scenario().wMc_start, r_sphere).visible_fraction, 0.0);
+  }
+}
+
+TEST(Truth, GroundTruthProblemFacesTheCamera) {
+  const Scenario s = wall_scene(0.6, "occluders: [{shape: sphere, radius: 0.03, position: [0, 0, 0.35]},"
+                                      " {shape: sphere, radius: 0.03, position: [0, 0, -0.5]}]");
+  Renderer r(s);
+  const ViewProblem p = r.ground_truth_problem(s.wMc_start, 0.02, 0.5);
+  ASSERT_GT(p.positions.cols(), 50);  // 0.2 x 0.2 m front face in 2 cm cells
+  for (Eigen::Index k = 0; k < p.normals.cols(); ++k) {
+    EXPECT_LT(p.normals(2, k), -0.9);  // towards the camera
+  }
+  ASSERT_GT(p.occluders.cols(), 0);
+  for (Eigen::Index k = 0; k < p.occluders.cols(); ++k) {
+    EXPECT_LT((p.occluders.col(k) - Eigen::Vector3d(0, 0, 0.6)).norm(), 0.5);  // only the one inside
+  }
+  const ViewEstimate e = estimate_view(p, EstimatorSettings{});
+  EXPECT_EQ(e.status, ViewStatus::Converged);
+  EXPECT_GT(e.iterations, 0);
+}
+
+TEST(Renderer, NoiseIsDeterministicPerFrame) {
+  const Scenario s = load_scenario("dvd-one-hand");
+  Renderer r(s);
+  r.set_time(1.0);
+  const RenderedFrame a = r.render(s.wMc_start, 30), b = r.render(s.wMc_start, 30), c = r.render(s.wMc_start, 31);
+  EXPECT_EQ(a.frame.depth, b.frame.depth);
+  EXPECT_NE(a.frame.depth, c.frame.depth);
+  EXPECT_EQ(a.labels, c.labels);  // labels are noise-free ground truth
+  std::size_t missing = 0, valid = 0;  // on the object, seen face-on
+  for (std::size_t i = 0; i < a.frame.depth.size(); ++i) {
+    if (a.labels[i] != kLabelObject) continue;
+    ++valid;
+    missing += a.frame.depth[i] == 0.0f ? 1 : 0;
+  }
+  EXPECT_GT(missing, 0U);            // edges and grazing pixels drop out
+  EXPECT_LT(missing, valid / 5);     // but most of the image is there
+}
+
+}  // namespace
+}  // namespace ofv::sim
