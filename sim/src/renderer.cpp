@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <random>
@@ -199,56 +200,76 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
   const Eigen::Matrix3d R = wMc.linear();
   const Eigen::Vector3d o = wMc.translation();
 
+  // Coherent rays of 8 neighbouring pixels are traced as one packet.
   auto render_rows = [&](int row0, int row1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    constexpr int kPacket = 8;
+    alignas(32) int valid[kPacket];
+    RTCRayHit8 rh;
     for (int v = row0; v < row1; ++v) {
-      for (int u = 0; u < k.width; ++u) {
-        // Camera ray with unit Z, so the hit distance is the depth Z.
-        const Eigen::Vector3d d = R * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
-        RTCRayHit rh{};
-        rh.ray.org_x = static_cast<float>(o.x());
-        rh.ray.org_y = static_cast<float>(o.y());
-        rh.ray.org_z = static_cast<float>(o.z());
-        rh.ray.dir_x = static_cast<float>(d.x());
-        rh.ray.dir_y = static_cast<float>(d.y());
-        rh.ray.dir_z = static_cast<float>(d.z());
-        rh.ray.tnear = static_cast<float>(sensor.min_depth);
-        rh.ray.tfar = static_cast<float>(sensor.max_depth);
-        rh.ray.mask = 0xFFFFFFFFu;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(impl_->scene, &context, &rh);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-        const std::size_t i = f.index(u, v);
-        const Eigen::Vector3d ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-        const double c = std::abs(ng.normalized().dot(d.normalized()));
-        f.depth[i] = rh.ray.tfar;
-        cos_incidence[i] = static_cast<float>(c);
-        out.labels[i] = impl_->labels[rh.hit.geomID];
-        const Eigen::Vector3f colour = scenario_.bodies[rh.hit.geomID].colour;
-        const float shade = static_cast<float>(0.35 + 0.65 * c);
-        for (int ch = 0; ch < 3; ++ch) {
-          f.rgb[3 * i + static_cast<std::size_t>(ch)] =
-              static_cast<std::uint8_t>(std::clamp(255.0f * colour[ch] * shade, 0.0f, 255.0f));
+      for (int u0 = 0; u0 < k.width; u0 += kPacket) {
+        for (int j = 0; j < kPacket; ++j) {
+          const int u = u0 + j;
+          valid[j] = u < k.width ? -1 : 0;
+          // Camera ray with unit Z, so the hit distance is the depth Z.
+          const Eigen::Vector3d d = R * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+          rh.ray.org_x[j] = static_cast<float>(o.x());
+          rh.ray.org_y[j] = static_cast<float>(o.y());
+          rh.ray.org_z[j] = static_cast<float>(o.z());
+          rh.ray.dir_x[j] = static_cast<float>(d.x());
+          rh.ray.dir_y[j] = static_cast<float>(d.y());
+          rh.ray.dir_z[j] = static_cast<float>(d.z());
+          rh.ray.tnear[j] = static_cast<float>(sensor.min_depth);
+          rh.ray.tfar[j] = static_cast<float>(sensor.max_depth);
+          rh.ray.mask[j] = 0xFFFFFFFFu;
+          rh.ray.time[j] = 0.0f;
+          rh.ray.flags[j] = 0;
+          rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, impl_->scene, &context, &rh);
+        for (int j = 0; j < kPacket && u0 + j < k.width; ++j) {
+          const unsigned geom = rh.hit.geomID[j];
+          if (geom == RTC_INVALID_GEOMETRY_ID) continue;
+          const std::size_t i = f.index(u0 + j, v);
+          const Eigen::Vector3d ng(rh.hit.Ng_x[j], rh.hit.Ng_y[j], rh.hit.Ng_z[j]);
+          const Eigen::Vector3d d(rh.ray.dir_x[j], rh.ray.dir_y[j], rh.ray.dir_z[j]);
+          const double c = std::abs(ng.normalized().dot(d.normalized()));
+          f.depth[i] = rh.ray.tfar[j];
+          cos_incidence[i] = static_cast<float>(c);
+          out.labels[i] = impl_->labels[geom];
+          const Eigen::Vector3f colour = scenario_.bodies[geom].colour;
+          const float shade = static_cast<float>(0.35 + 0.65 * c);
+          for (int ch = 0; ch < 3; ++ch) {
+            f.rgb[3 * i + static_cast<std::size_t>(ch)] =
+                static_cast<std::uint8_t>(std::clamp(255.0f * colour[ch] * shade, 0.0f, 255.0f));
+          }
         }
       }
     }
   };
+  // Rows in parallel; noise needs the clean depth of the neighbour rows, so it
+  // is a second parallel pass.
   const int threads = std::max(1, std::min<int>(static_cast<int>(std::thread::hardware_concurrency()), 8));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) {
-    pool.emplace_back(render_rows, k.height * t / threads, k.height * (t + 1) / threads);
-  }
-  render_rows(0, k.height / threads);
-  for (auto& t : pool) t.join();
+  auto in_parallel = [&](const std::function<void(int, int)>& rows) {
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) {
+      pool.emplace_back(rows, k.height * t / threads, k.height * (t + 1) / threads);
+    }
+    rows(0, k.height / threads);
+    for (auto& t : pool) t.join();
+  };
+  in_parallel(render_rows);
+  if (!noise) return out;
 
-  if (noise) {
-    // A generator per row, seeded from (scenario seed, frame, row): the same
-    // frame whatever the thread count.
-    const NoiseModel& m = sensor.noise;
-    const float cos_grazing = static_cast<float>(std::cos(m.grazing_deg * kDegToRad));
-    std::vector<float> clean = f.depth;
-    for (int v = 0; v < k.height; ++v) {
+  // A generator per row, seeded from (scenario seed, frame, row): the same
+  // frame whatever the thread count.
+  const NoiseModel& m = sensor.noise;
+  const float cos_grazing = static_cast<float>(std::cos(m.grazing_deg * kDegToRad));
+  const std::vector<float> clean = f.depth;
+  in_parallel([&](int row0, int row1) {
+    for (int v = row0; v < row1; ++v) {
       std::mt19937_64 rng(scenario_.seed * 0x9E3779B97F4A7C15ull ^
                           (static_cast<std::uint64_t>(frame_index) << 20) ^ static_cast<std::uint64_t>(v));
       std::normal_distribution<double> gauss(0.0, 1.0);
@@ -273,7 +294,7 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
         }
       }
     }
-  }
+  });
   return out;
 }
 
