@@ -33,6 +33,12 @@ Command add_estimate_command(CLI::App& app);
 /// Registers `ofv render` (a simulated frame to PNGs) on the app.
 Command add_render_command(CLI::App& app);
 
+/// Registers `ofv simulate` (the closed loop in simulation) on the app.
+Command add_simulate_command(CLI::App& app);
+
+/// Registers `ofv compare` (settings compared in closed loop) on the app.
+Command add_compare_command(CLI::App& app);
+
 /// Registers `ofv perceive` (perception front end + estimator over a source) on the app.
 Command add_perceive_command(CLI::App& app);
 

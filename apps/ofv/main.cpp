@@ -14,7 +14,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Print the help of every command");
 
-  std::vector<Command> commands{add_estimate_command(app)};
+  std::vector<Command> commands;
+#ifdef OFV_HAVE_LOOP  // built with the simulator and the servo library
+  commands.push_back(add_simulate_command(app));
+  commands.push_back(add_compare_command(app));
+#endif
+  commands.push_back(add_estimate_command(app));
 #ifdef OFV_HAVE_PERCEPTION  // built with the perception front end (OFV_BUILD_PERCEPTION)
   commands.push_back(add_perceive_command(app));
 #endif
