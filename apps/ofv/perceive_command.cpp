@@ -102,6 +102,7 @@ nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
           {"adjacency_edges", c.adjacency_edges},
           {"object", c.object},
           {"object_voxels", c.object_voxels},
+          {"hidden_voxels", c.hidden_voxels},
           {"interacting", c.interacting},
           {"occluders", c.occluders}};
 }

@@ -14,15 +14,17 @@ namespace ofv::detail {
 
 /// Supervoxels of one frame and the voxels they own.
 struct SupervoxelOutput {
-  std::vector<SupervoxelInfo> supervoxels;  // label Background, normal oriented to the camera
-  std::vector<Eigen::Vector3f> voxels;      // world frame [m]
-  std::vector<Eigen::Vector3f> colours;     // R, G, B per voxel
-  std::vector<int> owner;                   // index into supervoxels, per voxel
+  std::vector<SupervoxelInfo> supervoxels;    // label Background, normal oriented to the camera
+  std::vector<Eigen::Vector3f> voxels;        // world frame [m]
+  std::vector<Eigen::Vector3f> colours;       // R, G, B per voxel
+  std::vector<int> owner;                     // index into supervoxels, per voxel
+  std::vector<std::pair<int, int>> touching;  // pairs (i < j) whose voxels touch (PCL adjacency)
 
   void clear() {
     supervoxels.clear();
     voxels.clear();
     colours.clear();
+    touching.clear();
     owner.clear();
   }
 };

@@ -235,6 +235,7 @@ struct Perception::Impl {
   detail::SupervoxelOutput sv;
   PointGrid grid;  // reused for adjacency and tracking
   std::vector<Eigen::Vector3f> centroids;
+  std::vector<Eigen::Vector3d> object_cloud;  // classify(): visible + hidden object voxels
 
   // Object state carried from frame to frame (world frame).
   bool initialised = false;
@@ -454,7 +455,22 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
   for (std::size_t i = 0; i < n; ++i) {
     keep[i] = on_plane(r.supervoxels[i]) ? 0 : 1;
   }
-  const auto clusters = components(n, r.adjacency, keep);
+  // Neighbours: within R_adj (the paper's graph) or touching (PCL's voxel
+  // adjacency, which also links supervoxels grown larger than R_adj).
+  std::vector<std::pair<int, int>> neighbours = r.adjacency;
+  neighbours.insert(neighbours.end(), sv.touching.begin(), sv.touching.end());
+  // Clusters grow only across colour-consistent edges: a hand holding the
+  // object in the first frame is adjacent to it but of another colour.
+  std::vector<std::pair<int, int>> edges;
+  const double max_chroma = settings.tracking.max_chroma_distance;
+  for (const auto& [a, b] : neighbours) {
+    if (max_chroma <= 0.0 || (chroma(r.supervoxels[static_cast<std::size_t>(a)].colour) -
+                              chroma(r.supervoxels[static_cast<std::size_t>(b)].colour))
+                                     .norm() <= max_chroma) {
+      edges.emplace_back(a, b);
+    }
+  }
+  const auto clusters = components(n, edges, keep);
   double best = std::numeric_limits<double>::infinity();
   const std::vector<int>* chosen = nullptr;
   for (const auto& cluster : clusters) {
@@ -483,6 +499,54 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
   }
   for (int i : *chosen) {
     object[static_cast<std::size_t>(i)] = 1;
+  }
+  if (max_chroma <= 0.0) {
+    return object;
+  }
+  // Boundary supervoxels mix the object's colour with a foreign neighbour's
+  // (the table at its foot, the holding hand) and fall outside the colour-
+  // consistent cluster. One touching the object joins it when its
+  // chromaticity is nearer the object's mean than the mean of its foreign
+  // neighbours (those not of the object's colour); repeated until nothing
+  // joins. A supervoxel of a foreign colour is nearest its own kind and
+  // never joins.
+  Eigen::Vector3f object_chroma = Eigen::Vector3f::Zero();
+  for (int i : *chosen) {
+    object_chroma += chroma(r.supervoxels[static_cast<std::size_t>(i)].colour);
+  }
+  object_chroma /= static_cast<float>(chosen->size());
+  const auto limit = static_cast<float>(max_chroma);
+  std::vector<Eigen::Vector3f> foreign_sum(n, Eigen::Vector3f::Zero());
+  std::vector<int> foreign_count(n, 0);
+  for (const auto& [a, b] : neighbours) {
+    for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}}) {
+      const Eigen::Vector3f cy = chroma(r.supervoxels[static_cast<std::size_t>(y)].colour);
+      if ((cy - object_chroma).norm() > limit) {
+        foreign_sum[static_cast<std::size_t>(x)] += cy;
+        ++foreign_count[static_cast<std::size_t>(x)];
+      }
+    }
+  }
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const auto& [a, b] : neighbours) {
+      for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}}) {
+        const auto xi = static_cast<std::size_t>(x);
+        if (object[xi] || !object[static_cast<std::size_t>(y)] || !keep[xi]) {
+          continue;
+        }
+        const Eigen::Vector3f c = chroma(r.supervoxels[xi].colour);
+        const bool nearer_object =
+            foreign_count[xi] == 0
+                ? (c - object_chroma).norm() <= limit
+                : (c - object_chroma).norm() <
+                      (c - foreign_sum[xi] / static_cast<float>(foreign_count[xi])).norm();
+        if (nearer_object) {
+          object[xi] = 1;
+          grew = true;
+        }
+      }
+    }
   }
   return object;
 }
@@ -569,25 +633,34 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
 
 void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& object) {
   const std::size_t n = r.supervoxels.size();
-  // C and the PCA axes of the object's voxel cloud.
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  std::size_t count = 0;
+  // The object's voxel cloud: what is seen of it, plus the remembered voxels
+  // of its part hidden behind something nearer the camera, so that an
+  // occluder does not drag C, the axes and the OBB towards the visible part.
+  object_cloud.clear();
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     if (object[static_cast<std::size_t>(r.voxel_owner[i])]) {
-      sum += r.voxels[i].cast<double>();
-      ++count;
+      object_cloud.push_back(r.voxels[i].cast<double>());
     }
   }
-  r.counts.object_voxels = count;
-  const Eigen::Vector3d c = sum / static_cast<double>(count);
+  r.counts.object_voxels = object_cloud.size();
+  for (std::size_t i = 0; i < memory.size(); ++i) {
+    if (memory_age[i] > 0) {
+      object_cloud.push_back(memory[i].cast<double>());
+    }
+  }
+  r.counts.hidden_voxels = object_cloud.size() - r.counts.object_voxels;
+
+  // C and the PCA axes.
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : object_cloud) {
+    c += p;
+  }
+  c /= static_cast<double>(object_cloud.size());
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    if (object[static_cast<std::size_t>(r.voxel_owner[i])]) {
-      const Eigen::Vector3d d = r.voxels[i].cast<double>() - c;
-      cov += d * d.transpose();
-    }
+  for (const Eigen::Vector3d& p : object_cloud) {
+    cov += (p - c) * (p - c).transpose();
   }
-  cov /= static_cast<double>(count);
+  cov /= static_cast<double>(object_cloud.size());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   Eigen::Matrix3d axes;
   axes.col(0) = eig.eigenvectors().col(2);  // largest variance
@@ -596,15 +669,13 @@ void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& ob
   r.centroid = c;
   r.axes = axes;
 
-  // Augmented OBB: extents of the object voxels along the axes, plus the margin.
+  // Augmented OBB: extents of the object cloud along the axes, plus the margin.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
-  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    if (object[static_cast<std::size_t>(r.voxel_owner[i])]) {
-      const Eigen::Vector3d local = axes.transpose() * (r.voxels[i].cast<double>() - c);
-      lo = lo.cwiseMin(local);
-      hi = hi.cwiseMax(local);
-    }
+  for (const Eigen::Vector3d& p : object_cloud) {
+    const Eigen::Vector3d local = axes.transpose() * (p - c);
+    lo = lo.cwiseMin(local);
+    hi = hi.cwiseMax(local);
   }
   r.obb.axes = axes;
   r.obb.centre = c + axes * (0.5 * (lo + hi));

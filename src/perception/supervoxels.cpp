@@ -49,12 +49,12 @@ void cluster_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& sett
   std::map<std::uint32_t, pcl::Supervoxel<pcl::PointXYZRGBA>::Ptr> clusters;
   clustering.extract(clusters);
 
+  std::map<std::uint32_t, int> index_of_label;
   out.supervoxels.reserve(clusters.size());
   out.voxels.reserve(cloud.points.size());
   out.colours.reserve(cloud.points.size());
   out.owner.reserve(cloud.points.size());
   for (const auto& [label, sv] : clusters) {
-    (void)label;
     if (!sv || sv->voxels_->empty()) {
       continue;
     }
@@ -75,11 +75,21 @@ void cluster_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& sett
       info.normal_valid = false;
     }
     const int index = static_cast<int>(out.supervoxels.size());
+    index_of_label[label] = index;
     out.supervoxels.push_back(info);
     for (const pcl::PointXYZRGBA& p : *sv->voxels_) {
       out.voxels.emplace_back(p.x, p.y, p.z);
       out.colours.emplace_back(p.r, p.g, p.b);
       out.owner.push_back(index);
+    }
+  }
+  std::multimap<std::uint32_t, std::uint32_t> adjacency;
+  clustering.getSupervoxelAdjacency(adjacency);
+  for (const auto& [a, b] : adjacency) {
+    const auto ia = index_of_label.find(a);
+    const auto ib = index_of_label.find(b);
+    if (ia != index_of_label.end() && ib != index_of_label.end() && ia->second < ib->second) {
+      out.touching.emplace_back(ia->second, ib->second);
     }
   }
 }

@@ -85,8 +85,9 @@ struct TrackingSettings {
 /// \brief How the object is picked in the first frame.
 struct ObjectSelection {
   enum class Mode {
-    /// After removing the dominant plane (RANSAC), the cluster of adjacent
-    /// supervoxels nearest the image centre.
+    /// After removing the dominant plane (RANSAC), the cluster of adjacent,
+    /// colour-consistent supervoxels (chromaticities within
+    /// TrackingSettings::max_chroma_distance) nearest the image centre.
     Auto,
     Box,    ///< supervoxels whose centroid is inside `box` (world frame)
     Image,  ///< supervoxels whose centroid projects inside `rect` or onto a non-zero `mask` pixel
@@ -153,7 +154,8 @@ struct PerceptionCounts {
   std::size_t object = 0;
   std::size_t interacting = 0;
   std::size_t occluders = 0;
-  std::size_t object_voxels = 0;
+  std::size_t object_voxels = 0;  ///< seen in this frame
+  std::size_t hidden_voxels = 0;  ///< remembered behind occluders, added to the object cloud
 };
 
 /// \brief Wall time of each stage [ms].

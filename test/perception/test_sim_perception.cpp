@@ -1,0 +1,107 @@
+// The front end against the simulator's ground truth (ofv::sim renderer,
+// built-in scenarios with sensor noise).
+#include "ofv/perception/perception.h"
+#include "ofv/sim/renderer.h"
+#include "ofv/sim/scenario.h"
+
+#include "evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+namespace ofv {
+namespace {
+
+struct EpisodeStats {
+  int frames = 0;
+  int scored = 0;  // frames with the object at least 80 % visible
+  int lost = 0;
+  double worst_precision = 1.0;
+  double worst_recall = 1.0;
+  double worst_centroid_error = 0.0;
+  int frames_with_occluder_in_sphere = 0;
+  int frames_occluder_found = 0;
+  int frames_holder_visible = 0;
+  int frames_holder_interacting = 0;
+  int holder_as_object = 0;
+};
+
+/// Runs the front end on every frame of a scenario from its start camera, up to `until` [s].
+EpisodeStats run_scenario(const std::string& name, double until) {
+  const sim::Scenario scenario = sim::load_scenario(name);
+  sim::Renderer renderer(scenario);
+  PerceptionSettings settings;
+  Perception perception(settings);
+  EpisodeStats s;
+  const int frames = static_cast<int>(std::min(until, scenario.duration) * scenario.rate);
+  for (int k = 0; k < frames; ++k) {
+    renderer.set_time(k / scenario.rate);
+    const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
+    const RgbdFrame& frame = rendered.frame;
+    const std::vector<int> labels(rendered.labels.begin(), rendered.labels.end());
+    const PerceptionResult r = perception.process(frame);
+    ++s.frames;
+    if (r.status == TrackingStatus::Lost) {
+      ++s.lost;
+      continue;
+    }
+    const auto truth = test::supervoxel_truth(r, frame, labels);
+    const sim::ObjectTruth object = renderer.truth(scenario.wMc_start, settings.r_sphere);
+    if (object.visible_fraction >= 0.8) {
+      ++s.scored;
+      const auto score = test::score_object(r, truth, sim::kLabelObject);
+      s.worst_precision = std::min(s.worst_precision, score.precision);
+      s.worst_recall = std::min(s.worst_recall, score.recall);
+      s.worst_centroid_error =
+          std::max(s.worst_centroid_error, (r.centroid - object.centroid).norm());
+    }
+    // Occluders: every occluder label seen in the image whose supervoxels lie
+    // inside the sphere must give occluder supervoxels.
+    std::set<int> occluders_in_sphere;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      if (truth[i] >= sim::kLabelOccluder0 &&
+          (r.supervoxels[i].centroid - r.centroid).norm() < settings.r_sphere &&
+          !r.obb.contains(r.supervoxels[i].centroid)) {
+        occluders_in_sphere.insert(truth[i]);
+      }
+    }
+    for (const int label : occluders_in_sphere) {
+      ++s.frames_with_occluder_in_sphere;
+      s.frames_occluder_found +=
+          test::count_truth_as(r, truth, label, SupervoxelClass::Occluder) > 0 ? 1 : 0;
+    }
+    if (std::count(truth.begin(), truth.end(), sim::kLabelInteracting) > 0) {
+      ++s.frames_holder_visible;
+      s.frames_holder_interacting +=
+          test::count_truth_as(r, truth, sim::kLabelInteracting, SupervoxelClass::Interacting) > 0
+              ? 1
+              : 0;
+      s.holder_as_object +=
+          test::count_truth_as(r, truth, sim::kLabelInteracting, SupervoxelClass::Object);
+    }
+  }
+  return s;
+}
+
+void expect_quality(const EpisodeStats& s) {
+  EXPECT_EQ(s.lost, 0);
+  EXPECT_GT(s.scored, 0);
+  EXPECT_GE(s.worst_precision, 0.95);
+  EXPECT_GE(s.worst_recall, 0.90);
+  EXPECT_LE(s.worst_centroid_error, 0.01);
+  EXPECT_EQ(s.frames_occluder_found, s.frames_with_occluder_in_sphere);
+  EXPECT_EQ(s.frames_holder_interacting, s.frames_holder_visible);
+  EXPECT_EQ(s.holder_as_object, 0);
+}
+
+TEST(SimPerception, DvdOneHand) {
+  const EpisodeStats s = run_scenario("dvd-one-hand", 2.5);
+  expect_quality(s);
+  EXPECT_GT(s.frames_with_occluder_in_sphere, 0) << "the entering hand never reached the sphere";
+  EXPECT_GT(s.frames_holder_visible, 0);
+}
+
+}  // namespace
+}  // namespace ofv
