@@ -20,7 +20,8 @@ struct EpisodeStats {
   int lost = 0;
   double worst_precision = 1.0;
   double worst_recall = 1.0;
-  double worst_centroid_error = 0.0;
+  double worst_centroid_error = 0.0;          // against the whole object's surface centroid
+  double worst_visible_centroid_error = 0.0;  // against the object-labelled voxels' mean
   int frames_with_occluder_in_sphere = 0;
   int frames_occluder_found = 0;
   int frames_holder_visible = 0;
@@ -56,6 +57,11 @@ EpisodeStats run_scenario(const std::string& name, double until) {
       s.worst_recall = std::min(s.worst_recall, score.recall);
       s.worst_centroid_error =
           std::max(s.worst_centroid_error, (r.centroid - object.centroid).norm());
+      if (r.counts.hidden_voxels == 0) {
+        s.worst_visible_centroid_error = std::max(
+            s.worst_visible_centroid_error,
+            (r.centroid - test::truth_centroid(r, frame, labels, sim::kLabelObject)).norm());
+      }
     }
     // Occluders: every occluder label seen in the image whose supervoxels lie
     // inside the sphere must give occluder supervoxels.
@@ -85,12 +91,15 @@ EpisodeStats run_scenario(const std::string& name, double until) {
   return s;
 }
 
-void expect_quality(const EpisodeStats& s) {
+void expect_quality(const EpisodeStats& s, bool whole_object_centroid = true) {
   EXPECT_EQ(s.lost, 0);
   EXPECT_GT(s.scored, 0);
   EXPECT_GE(s.worst_precision, 0.95);
   EXPECT_GE(s.worst_recall, 0.90);
-  EXPECT_LE(s.worst_centroid_error, 0.01);
+  if (whole_object_centroid) {
+    EXPECT_LE(s.worst_centroid_error, 0.01);
+  }
+  EXPECT_LE(s.worst_visible_centroid_error, 0.01);
   EXPECT_EQ(s.frames_occluder_found, s.frames_with_occluder_in_sphere);
   EXPECT_EQ(s.frames_holder_interacting, s.frames_holder_visible);
   EXPECT_EQ(s.holder_as_object, 0);
@@ -101,6 +110,35 @@ TEST(SimPerception, DvdOneHand) {
   expect_quality(s);
   EXPECT_GT(s.frames_with_occluder_in_sphere, 0) << "the entering hand never reached the sphere";
   EXPECT_GT(s.frames_holder_visible, 0);
+}
+
+TEST(SimPerception, DvdStatic) {
+  const EpisodeStats s = run_scenario("dvd-static", 3.0);
+  expect_quality(s);
+  EXPECT_GT(s.frames_holder_visible, 0);
+}
+
+TEST(SimPerception, DvdTwoHands) {
+  const EpisodeStats s = run_scenario("dvd-two-hands", 4.0);
+  expect_quality(s);
+  EXPECT_GT(s.frames_with_occluder_in_sphere, 0);
+}
+
+TEST(SimPerception, ClothOccluder) {
+  const EpisodeStats s = run_scenario("cloth-occluder", 4.0);
+  expect_quality(s);
+  EXPECT_GT(s.frames_with_occluder_in_sphere, 0);
+}
+
+// The case slides 0.2 m and turns 20 degrees into a static hand. While it
+// slides behind the hand no voxel of the hidden part stays hidden long
+// enough to be remembered (its old position shows the case itself), so C is
+// the visible part's mean: up to ~2 cm from the whole case's centroid at 80 %
+// visibility. Checked against the visible voxels instead.
+TEST(SimPerception, MovingObject) {
+  const EpisodeStats s = run_scenario("moving-object", 5.0);
+  expect_quality(s, /*whole_object_centroid=*/false);
+  EXPECT_GT(s.frames_with_occluder_in_sphere, 0);
 }
 
 }  // namespace
