@@ -42,4 +42,7 @@ Command add_compare_command(CLI::App& app);
 /// Registers `ofv perceive` (perception front end + estimator over a source) on the app.
 Command add_perceive_command(CLI::App& app);
 
+/// Registers `ofv record` (a simulated episode exported as .oni/TUM/PCD) on the app.
+Command add_record_command(CLI::App& app);
+
 }  // namespace ofv::cli

@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
 #ifdef OFV_HAVE_SIM  // built with the simulator (OFV_BUILD_SIM)
   commands.push_back(add_render_command(app));
 #endif
+#ifdef OFV_HAVE_RECORD  // built with the simulator and the perception sources
+  commands.push_back(add_record_command(app));
+#endif
   app.footer(estimator_settings_help());
 
   std::string known;

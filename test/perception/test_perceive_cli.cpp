@@ -2,6 +2,7 @@
 #include "ofv/sources/openni2_source.h"
 #include "ofv/sources/tum_sequence.h"
 
+#include "cli_run.h"
 #include "synthetic_scene.h"
 
 #include <gtest/gtest.h>
@@ -17,34 +18,6 @@ namespace fs = std::filesystem;
 
 namespace ofv {
 namespace {
-
-struct CommandRun {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-CommandRun run(const std::string& args) {
-  const fs::path err = fs::path(testing::TempDir()) / "ofv_perceive_stderr.txt";
-  const std::string command = std::string(OFV_BINARY) + " " + args + " 2>" + err.string();
-  CommandRun r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    return r;
-  }
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) {
-    r.out.append(buffer, n);
-  }
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  return r;
-}
 
 /// Frame 0 sees the case alone; then a hand grips it and an arm passes in front.
 std::vector<RgbdFrame> episode() {

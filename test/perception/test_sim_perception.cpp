@@ -4,11 +4,13 @@
 #include "ofv/sim/renderer.h"
 #include "ofv/sim/scenario.h"
 
+#include "cli_run.h"
 #include "evaluation.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <set>
 
 namespace ofv {
@@ -139,6 +141,25 @@ TEST(SimPerception, MovingObject) {
   const EpisodeStats s = run_scenario("moving-object", 5.0);
   expect_quality(s, /*whole_object_centroid=*/false);
   EXPECT_GT(s.frames_with_occluder_in_sphere, 0);
+}
+
+TEST(SimPerception, RecordedEpisodesPlayBackThroughPerceive) {
+  for (const std::string format : {"oni", "tum", "pcd"}) {
+    const std::string out = (std::filesystem::path(testing::TempDir()) /
+                             ("ofv_record_" + format + (format == "oni" ? ".oni" : "")))
+                                .string();
+    std::filesystem::remove_all(out);
+    const CommandRun rec =
+        run("record dvd-one-hand --format " + format + " --out " + out + " --until 0.5");
+    ASSERT_EQ(rec.code, 0) << rec.err;
+    const CommandRun perceive = run("perceive " + out);
+    ASSERT_EQ(perceive.code, 0) << perceive.err;
+    EXPECT_NE(perceive.err.find("15 frames, 0 lost"), std::string::npos)
+        << format << ": " << perceive.err;
+  }
+  const CommandRun bad = run("record no-such-scenario --out /tmp/ofv_never");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1);
 }
 
 }  // namespace
