@@ -10,24 +10,26 @@
 
 namespace ofv {
 
-bool is_blank_or_comment(const std::string& line) {
-  const auto first = line.find_first_not_of(" \t\r");
-  return first == std::string::npos || line[first] == '#';
-}
-
-std::vector<StampedPose> read_pose_file(const std::string& path) {
+void for_each_data_line(const std::string& path, const std::string& what,
+                        const std::function<void(const std::string&, int)>& f) {
   std::ifstream in(path);
   if (!in) {
-    throw std::runtime_error(path + ": cannot open the pose file");
+    throw std::runtime_error(path + ": cannot open the " + what);
   }
-  std::vector<StampedPose> poses;
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
-    if (is_blank_or_comment(line)) {
-      continue;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first != std::string::npos && line[first] != '#') {
+      f(line, number);
     }
+  }
+}
+
+std::vector<StampedPose> read_pose_file(const std::string& path) {
+  std::vector<StampedPose> poses;
+  for_each_data_line(path, "pose file", [&](const std::string& line, int number) {
     std::istringstream fields(line);
     double t = 0, tx = 0, ty = 0, tz = 0, qx = 0, qy = 0, qz = 0, qw = 0;
     if (!(fields >> t >> tx >> ty >> tz >> qx >> qy >> qz >> qw)) {
@@ -44,7 +46,7 @@ std::vector<StampedPose> read_pose_file(const std::string& path) {
     p.wMc.linear() = q.normalized().toRotationMatrix();
     p.wMc.translation() = Eigen::Vector3d(tx, ty, tz);
     poses.push_back(p);
-  }
+  });
   std::stable_sort(poses.begin(), poses.end(),
                    [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; });
   return poses;
@@ -81,14 +83,10 @@ Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double
 }
 
 CameraIntrinsics read_intrinsics_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open the intrinsics file");
-  }
-  std::string line;
-  while (std::getline(in, line)) {
-    if (is_blank_or_comment(line)) {
-      continue;
+  std::optional<CameraIntrinsics> found;
+  for_each_data_line(path, "intrinsics file", [&](const std::string& line, int) {
+    if (found) {
+      return;
     }
     std::istringstream fields(line);
     CameraIntrinsics k;
@@ -96,9 +94,12 @@ CameraIntrinsics read_intrinsics_file(const std::string& path) {
         k.height <= 0 || !(k.fx > 0.0) || !(k.fy > 0.0)) {
       throw std::runtime_error(path + ": expected 'width height fx fy cx cy', got '" + line + "'");
     }
-    return k;
+    found = k;
+  });
+  if (!found) {
+    throw std::runtime_error(path + ": no 'width height fx fy cx cy' line");
   }
-  throw std::runtime_error(path + ": no 'width height fx fy cx cy' line");
+  return *found;
 }
 
 void write_intrinsics_file(const std::string& path, const CameraIntrinsics& k) {

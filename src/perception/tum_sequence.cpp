@@ -27,26 +27,17 @@ struct ListEntry {
 };
 
 std::vector<ListEntry> read_list(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open (not a TUM RGB-D sequence?)");
-  }
   std::vector<ListEntry> out;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (is_blank_or_comment(line)) {
-      continue;
-    }
-    std::istringstream fields(line);
-    ListEntry e{};
-    if (!(fields >> e.time >> e.file) || !std::isfinite(e.time)) {
-      throw std::runtime_error(path + ":" + std::to_string(number) +
-                               ": expected 'timestamp filename', got '" + line + "'");
-    }
-    out.push_back(e);
-  }
+  for_each_data_line(
+      path, "list (not a TUM RGB-D sequence?)", [&](const std::string& line, int number) {
+        std::istringstream fields(line);
+        ListEntry e{};
+        if (!(fields >> e.time >> e.file) || !std::isfinite(e.time)) {
+          throw std::runtime_error(path + ":" + std::to_string(number) +
+                                   ": expected 'timestamp filename', got '" + line + "'");
+        }
+        out.push_back(e);
+      });
   std::stable_sort(out.begin(), out.end(),
                    [](const ListEntry& a, const ListEntry& b) { return a.time < b.time; });
   return out;

@@ -9,14 +9,21 @@
 
 #include <Eigen/Geometry>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace ofv {
 
-/// \brief True for a line of a sequence text file that holds no data: blank or `#` comment.
-[[nodiscard]] bool is_blank_or_comment(const std::string& line);
+/**
+ * rief Calls `f(line, number)` for each data line of a sequence text file:
+ *        blank lines and `#` comments are skipped; numbers count from 1.
+ * 	hrows std::runtime_error "PATH: cannot open the WHAT" when unreadable,
+ *         and whatever `f` throws.
+ */
+void for_each_data_line(const std::string& path, const std::string& what,
+                        const std::function<void(const std::string&, int)>& f);
 
 /// \brief A timestamped camera pose wMc (camera -> world), ViSP camera axes.
 struct StampedPose {
