@@ -1,0 +1,112 @@
+/**
+ * \file robot.h
+ * \brief Eye-in-hand robots as the closed loop sees them: take a camera
+ *        twist for one frame period, report the new camera pose.
+ *
+ * - FreeFlyingCamera: integrates the twist exactly (like vpSimulatorCamera),
+ *   deterministic.
+ * - KinematicArm on ViSP's kinematic models of the Viper850 (6-axis arm) and
+ *   the Afma6 (gantry): q̇ = (cVe eJe)^+ v, integrated over dt, clamped to the
+ *   joint limits; faster than real time and deterministic (the threaded
+ *   vpSimulatorViper850/Afma6 integrate in wall-clock time: RealtimeRobot).
+ * - VispRobot: any ViSP vpRobot driver (real or threaded simulator) through
+ *   setVelocity(CAMERA_FRAME) and its measured pose.
+ *
+ * The world frame W is the scenario's: an arm's base is placed so that its
+ * start configuration puts the camera at the requested start pose.
+ */
+#pragma once
+
+#include <visp3/core/vpColVector.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <memory>
+#include <string>
+
+class vpRobot;
+
+namespace ofv {
+
+/// \brief Result of one robot step.
+struct RobotStep {
+  vpHomogeneousMatrix wMc;  ///< camera pose after the step
+  bool limited = false;     ///< a joint limit (or the workspace) stopped part of the motion
+};
+
+/// \brief A robot carrying the camera.
+class CameraRobot {
+ public:
+  virtual ~CameraRobot() = default;
+  /// \brief Current camera pose in the world.
+  [[nodiscard]] virtual vpHomogeneousMatrix wMc() const = 0;
+  /// \brief Applies the camera twist v (camera frame, [m/s, rad/s]) for dt seconds.
+  virtual RobotStep step(const vpColVector& v, double dt) = 0;
+  [[nodiscard]] virtual std::string name() const = 0;
+};
+
+/// \brief A free-flying camera, integrated exactly with vpExponentialMap.
+class FreeFlyingCamera : public CameraRobot {
+ public:
+  explicit FreeFlyingCamera(const vpHomogeneousMatrix& wMc);
+  [[nodiscard]] vpHomogeneousMatrix wMc() const override { return wMc_; }
+  RobotStep step(const vpColVector& v, double dt) override;
+  [[nodiscard]] std::string name() const override { return "camera"; }
+
+ private:
+  vpHomogeneousMatrix wMc_;
+};
+
+/// \brief A ViSP arm model (vpViper850 or vpAfma6) stepped on its kinematics.
+class KinematicArm : public CameraRobot {
+ public:
+  enum class Model { Viper850, Afma6 };
+  /// \param wMc_start camera start pose; the base is placed to match it.
+  KinematicArm(Model model, const vpHomogeneousMatrix& wMc_start);
+  ~KinematicArm() override;
+  [[nodiscard]] vpHomogeneousMatrix wMc() const override;
+  RobotStep step(const vpColVector& v, double dt) override;
+  [[nodiscard]] std::string name() const override;
+  [[nodiscard]] const vpColVector& joints() const { return q_; }
+  [[nodiscard]] vpColVector joint_min() const;
+  [[nodiscard]] vpColVector joint_max() const;
+  /// \brief Sets the joints (clamped to the limits); for tests and start poses.
+  void set_joints(const vpColVector& q);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  vpColVector q_;
+  vpHomogeneousMatrix wMf_;  // base in the world
+};
+
+/**
+ * \brief Any ViSP robot (a real driver such as vpRobotViper850, vpRobotAfma6,
+ *        vpRobotFranka, vpRobotUniversalRobots, or a threaded simulator),
+ *        commanded in the camera frame. step() sends the velocity with
+ *        setVelocity(CAMERA_FRAME), lets dt elapse on the wall clock
+ *        (vpTime::wait) and reads the camera pose back with
+ *        getPosition(REFERENCE_FRAME) (ViSP's drivers report the camera
+ *        frame there once their tool/eMc is set); `fMw` places the world.
+ */
+class VispRobot : public CameraRobot {
+ public:
+  VispRobot(vpRobot& robot, const vpHomogeneousMatrix& fMw, std::string name);
+  [[nodiscard]] vpHomogeneousMatrix wMc() const override;
+  RobotStep step(const vpColVector& v, double dt) override;
+  [[nodiscard]] std::string name() const override { return name_; }
+  /// \brief Zero velocity now (Ctrl-C, lost object).
+  void stop();
+
+ private:
+  vpRobot& robot_;
+  vpHomogeneousMatrix wMf_;
+  std::string name_;
+};
+
+/**
+ * \brief `camera` (FreeFlyingCamera), `viper850` or `afma6` (KinematicArm).
+ * \throws std::invalid_argument naming an unknown robot.
+ */
+[[nodiscard]] std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start);
+
+}  // namespace ofv

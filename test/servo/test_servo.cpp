@@ -1,0 +1,192 @@
+// The servo side: target pose, the sphere feature against finite differences,
+// the controller in closed loop, robots, the safety filter.
+#include "ofv/servo/controller.h"
+#include "ofv/servo/robot.h"
+#include "ofv/servo/safety.h"
+#include "ofv/servo/target_pose.h"
+
+#include <gtest/gtest.h>
+#include <visp3/core/vpExponentialMap.h>
+
+#include <random>
+
+namespace ofv {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A camera at position p looking at `at` (y roughly down).
+vpHomogeneousMatrix looking_at(const Eigen::Vector3d& p, const Eigen::Vector3d& at) {
+  const Eigen::Vector3d z = (at - p).normalized();
+  Eigen::Vector3d y = Eigen::Vector3d(0, 1, 0) - z.y() * z;
+  if (y.norm() < 1e-6) y = Eigen::Vector3d(1, 0, 0) - z.x() * z;
+  y.normalize();
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.linear() << y.cross(z), y, z;
+  m.translation() = p;
+  return to_visp(m);
+}
+
+TEST(TargetPose, LooksAtTheCentroidWithTheLeastRotation) {
+  const Eigen::Vector3d c(0.1, -0.2, 1.0), t(0.4, -0.1, 0.6);
+  const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, c);
+  const Eigen::Isometry3d wMcd = to_eigen(target_pose(t, c, wMc));
+  EXPECT_TRUE(wMcd.translation().isApprox(t));
+  EXPECT_TRUE(wMcd.linear().col(2).isApprox((c - t).normalized(), 1e-12));
+  // The rotation between the two orientations is the angle between their Z axes.
+  const Eigen::Matrix3d cRcd = to_eigen(wMc).linear().transpose() * wMcd.linear();
+  const double angle = Eigen::AngleAxisd(cRcd).angle();
+  EXPECT_NEAR(angle, std::acos(to_eigen(wMc).linear().col(2).dot(wMcd.linear().col(2))), 1e-9);
+  // Already looking at C: the orientation is kept exactly.
+  const vpHomogeneousMatrix same = target_pose(Eigen::Vector3d(0, 0, 0), c, wMc);
+  EXPECT_TRUE(to_eigen(same).linear().isApprox(to_eigen(wMc).linear(), 1e-12));
+  EXPECT_THROW((void)target_pose(c, c, wMc), std::invalid_argument);
+}
+
+// s after the camera moves by twist v for a time h.
+vpColVector feature_after(const vpHomogeneousMatrix& wMc, const vpColVector& c, const vpColVector& t,
+                          const vpColVector& v, double h) {
+  FeatureSphereView s;
+  s.build((wMc * vpExponentialMap::direct(v, h)).inverse(), c, t, 0.5);
+  return s.get_s();
+}
+
+TEST(FeatureSphereView, InteractionMatrixMatchesFiniteDifferences) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const vpColVector c{0.3 * u(rng), 0.3 * u(rng), 1.0 + 0.3 * u(rng)};
+    const vpColVector t{u(rng), u(rng), u(rng)};
+    const vpHomogeneousMatrix wMc = looking_at({0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng)},
+                                               {c[0] + 0.05 * u(rng), c[1], c[2]});
+    FeatureSphereView s;
+    s.build(wMc.inverse(), c, t, 0.5);
+    const vpMatrix L = s.interaction();
+    ASSERT_EQ(L.getRows(), 6U);
+    for (int k = 0; k < 6; ++k) {
+      vpColVector v(6);
+      for (unsigned i = 0; i < 6; ++i) v[i] = u(rng);
+      const double h = 1e-6;
+      const vpColVector numeric = (feature_after(wMc, c, t, v, h) - feature_after(wMc, c, t, v, -h)) / (2 * h);
+      const vpColVector analytic = L * v;
+      for (unsigned i = 0; i < 6; ++i) EXPECT_NEAR(numeric[i], analytic[i], 1e-6) << "row " << i;
+    }
+  }
+  // Selection keeps the chosen rows.
+  FeatureSphereView s;
+  const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, {0, 0, 0.5});
+  s.build(wMc.inverse(), vpColVector{0.0, 0.0, 0.5}, vpColVector{0.5, 0.0, 0.5}, 0.5);
+  EXPECT_EQ(s.interaction(FeatureSphereView::selectRho() | FeatureSphereView::selectX()).getRows(), 2U);
+  EXPECT_THROW(s.build(wMc.inverse(), vpColVector{0.0, 0.0, -0.5}, vpColVector{1.0, 0.0, 0.0}, 0.5),
+               std::invalid_argument);
+}
+
+// Servo a free-flying camera from a view on the sphere towards a target view
+// 90 degrees away; returns the largest |distance to C - R| and the smallest distance.
+std::pair<double, double> servo_to(ControllerSettings::Law law, double* final_error = nullptr) {
+  const Eigen::Vector3d c(0, 0, 0.5), tf(0.5, 0, 0.5);
+  const double r = 0.5;
+  ControllerSettings settings;
+  settings.law = law;
+  ViewController controller(settings);
+  FreeFlyingCamera camera(looking_at({0, 0, 0}, c));
+  double worst = 0.0, nearest = 1e9;
+  for (int k = 0; k < 150; ++k) {
+    const vpColVector v = controller.update(tf, c, r, camera.wMc(), 1.0 / 30);
+    camera.step(v, 1.0 / 30);
+    const double dist = (to_eigen(camera.wMc()).translation() - c).norm();
+    worst = std::max(worst, std::abs(dist - r));
+    nearest = std::min(nearest, dist);
+  }
+  if (final_error) *final_error = (to_eigen(camera.wMc()).translation() - tf).norm();
+  return {worst, nearest};
+}
+
+TEST(ViewController, TheSphereLawTravelsAlongTheSphereWhilePbvsCutsTheChord) {
+  double err_sphere = 0.0, err_pbvs = 0.0;
+  const auto sphere = servo_to(ControllerSettings::Law::Sphere, &err_sphere);
+  const auto pbvs = servo_to(ControllerSettings::Law::Pbvs, &err_pbvs);
+  EXPECT_LT(sphere.first, 0.02);
+  EXPECT_LT(pbvs.second, 0.5 - 0.1);  // the chord passes ~0.35 m from C
+  EXPECT_LT(err_sphere, 0.005);       // both arrive
+  EXPECT_LT(err_pbvs, 0.005);
+}
+
+TEST(ViewController, CommandsAreBoundedAndFinite) {
+  ControllerSettings s;
+  s.gain = 1000.0;
+  ViewController controller(s);
+  const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, {0, 0, 0.5});
+  const vpColVector v = controller.update({0.5, 0, 0.5}, {0, 0, 0.5}, 0.5, wMc, 1.0 / 30);
+  EXPECT_LE(std::hypot(v[0], v[1], v[2]), s.max_linear_speed + 1e-12);
+  EXPECT_LE(std::hypot(v[3], v[4], v[5]), s.max_angular_speed + 1e-12);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(controller.update({nan, 0, 0}, {0, 0, 0.5}, 0.5, wMc, 0.03).frobeniusNorm(), 0.0);
+  EXPECT_EQ(controller.update({0, 0, 0.5}, {0, 0, 0.5}, 0.5, wMc, 0.03).frobeniusNorm(), 0.0);
+  ControllerSettings bad;
+  bad.max_linear_speed = -1;
+  EXPECT_THROW(ViewController{bad}, std::invalid_argument);
+}
+
+TEST(Robots, FollowAConstantTwist) {
+  const vpHomogeneousMatrix start = looking_at({0, 0, 0}, {0, 0, 0.5});
+  const vpColVector v{0.05, -0.02, 0.03, 0.1, -0.05, 0.08};
+  for (const std::string name : {"camera", "viper850", "afma6"}) {
+    auto robot = make_robot(name, start);
+    EXPECT_TRUE(to_eigen(robot->wMc()).isApprox(to_eigen(start), 1e-9)) << name;
+    const double dt = 0.01;
+    const RobotStep step = robot->step(v, dt);
+    const Eigen::Isometry3d expected = to_eigen(start * vpExponentialMap::direct(v, dt));
+    EXPECT_LT((to_eigen(step.wMc).translation() - expected.translation()).norm(), 1e-5) << name;
+    EXPECT_LT(Eigen::AngleAxisd(to_eigen(step.wMc).linear().transpose() * expected.linear()).angle(), 1e-4) << name;
+    EXPECT_FALSE(step.limited) << name;
+  }
+  EXPECT_THROW((void)make_robot("puma560", start), std::invalid_argument);
+}
+
+TEST(Robots, JointLimitsClamp) {
+  KinematicArm arm(KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
+  bool limited = false;
+  for (int k = 0; k < 400 && !limited; ++k) limited = arm.step(vpColVector{0, 0, 0, 0, 0, 1.0}, 0.05).limited;
+  EXPECT_TRUE(limited);
+  const vpColVector q = arm.joints(), lo = arm.joint_min(), hi = arm.joint_max();
+  for (unsigned i = 0; i < 6; ++i) {
+    EXPECT_GE(q[i], lo[i]);
+    EXPECT_LE(q[i], hi[i]);
+  }
+}
+
+TEST(Safety, EachRule) {
+  SafetySettings s;
+  s.workspace = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 0.05));
+  const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, {0, 0, 0.5});
+  const vpColVector fast{1.0, 0, 0, 0, 0, 0};
+  {
+    SafetyFilter f(s);
+    EXPECT_EQ(f.filter(fast, wMc, 0.03, false, 0.0).frobeniusNorm(), 0.0);
+    EXPECT_STREQ(f.last_reason(), "object lost");
+    EXPECT_EQ(f.filter(fast, wMc, 0.03, true, 1.0).frobeniusNorm(), 0.0);
+    EXPECT_STREQ(f.last_reason(), "stale frame");
+  }
+  {
+    SafetyFilter f(s);  // from rest, the acceleration limit binds first
+    const vpColVector v = f.filter(fast, wMc, 0.03, true, 0.0);
+    EXPECT_NEAR(v[0], s.max_linear_accel * 0.03, 1e-12);
+    for (int k = 0; k < 100; ++k) (void)f.filter(fast, wMc, 0.03, true, 0.0);
+    EXPECT_NEAR(f.filter(fast, wMc, 0.03, true, 0.0)[0], s.max_linear_speed, 1e-12);
+  }
+  {
+    SafetyFilter f(s);  // forward (+z world) would leave the box at z = 0.05
+    vpHomogeneousMatrix at_edge = wMc;
+    at_edge[2][3] = 0.05;
+    vpColVector forward(6, 0.0);
+    forward[2] = 0.01;
+    EXPECT_EQ(f.filter(forward, at_edge, 0.03, true, 0.0)[2], 0.0);
+    EXPECT_STREQ(f.last_reason(), "workspace bound");
+  }
+  SafetyFilter f(s);
+  EXPECT_EQ(f.filter(vpColVector{std::nan(""), 0, 0, 0, 0, 0}, wMc, 0.03, true, 0.0).frobeniusNorm(), 0.0);
+}
+
+}  // namespace
+}  // namespace ofv
