@@ -3,6 +3,7 @@
 
 #include "ofv/io/scene_json.h"
 #include "ofv/servo/robot.h"
+#include "ofv/servo/target_pose.h"
 #include "ofv/sim/renderer.h"
 
 #ifdef OFV_LOOP_HAVE_PERCEPTION
@@ -22,24 +23,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-vpHomogeneousMatrix to_visp(const Eigen::Isometry3d& m) {
-  vpHomogeneousMatrix h;
-  for (unsigned r = 0; r < 3; ++r) {
-    for (unsigned c = 0; c < 3; ++c) h[r][c] = m.linear()(r, c);
-    h[r][3] = m.translation()(r);
-  }
-  return h;
-}
-
-Eigen::Isometry3d to_eigen(const vpHomogeneousMatrix& h) {
-  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) m.linear()(r, c) = h[static_cast<unsigned>(r)][static_cast<unsigned>(c)];
-    m.translation()(r) = h[static_cast<unsigned>(r)][3];
-  }
-  return m;
 }
 
 double positive_number(const std::string& name, const std::string& value) {

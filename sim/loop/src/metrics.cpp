@@ -78,17 +78,33 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold)
   m.status_counts.assign(statuses.begin(), statuses.end());
 
   // Occlusion events: the ground-truth count of occluders in the sphere rises.
+  // An event lasts until the next one (or the end); it has recovered once the
+  // visibility is back at or above the threshold for the rest of it.
+  std::vector<std::size_t> onsets;
   for (std::size_t k = 1; k < steps.size(); ++k) {
-    if (steps[k].occluders_in_sphere <= steps[k - 1].occluders_in_sphere) continue;
-    OcclusionEvent e;
-    e.onset = steps[k].time;
-    for (std::size_t j = k; j < steps.size(); ++j) {
-      if (steps[j].visible_fraction >= threshold) {
-        e.recovery_time = steps[j].time - e.onset;
-        break;
+    if (steps[k].occluders_in_sphere > steps[k - 1].occluders_in_sphere) onsets.push_back(k);
+  }
+  for (std::size_t e = 0; e < onsets.size(); ++e) {
+    const std::size_t begin = onsets[e];
+    const std::size_t end = e + 1 < onsets.size() ? onsets[e + 1] : steps.size();
+    OcclusionEvent event;
+    event.onset = steps[begin].time;
+    std::size_t last_below = begin;
+    bool dropped = false;
+    for (std::size_t j = begin; j < end; ++j) {
+      if (steps[j].visible_fraction < threshold) {
+        last_below = j;
+        dropped = true;
       }
     }
-    m.occlusions.push_back(e);
+    if (!dropped) {
+      event.recovery_time = 0.0;
+    } else if (last_below + 1 < end) {
+      event.recovery_time = steps[last_below + 1].time - event.onset;
+    } else if (end < steps.size()) {
+      event.recovery_time = std::nullopt;  // still hidden when the next occluder came
+    }
+    m.occlusions.push_back(event);
   }
   double worst = 0.0;
   for (const auto& e : m.occlusions) {

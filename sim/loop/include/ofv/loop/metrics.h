@@ -45,7 +45,7 @@ struct StepRecord {
 /// \brief One occlusion event: an occluder entered the sphere.
 struct OcclusionEvent {
   double onset = 0.0;                   ///< time the occluder count rose [s]
-  std::optional<double> recovery_time;  ///< time to visibility >= threshold again [s]; none if never
+  std::optional<double> recovery_time;  ///< time until visibility stays >= threshold [s]; none if never
 };
 
 /// \brief Summary of an episode.
@@ -75,8 +75,10 @@ struct EpisodeMetrics {
  * \param steps  records in time order, one per frame period.
  * \param threshold  visibility counted as "in view" [0, 1].
  * Each step stands for the interval until the next one (the last for the
- * mean period). Recovery is measured from the onset to the first step at or
- * after it whose visibility is >= threshold (0 when it never dropped).
+ * mean period). An occlusion event runs from an onset (the occluder count
+ * rises) to the next onset or the end; its recovery time is from the onset
+ * to the step after which visibility stays >= threshold for the rest of the
+ * event (0 when it never dropped, none when it is still below at the end).
  */
 [[nodiscard]] EpisodeMetrics summarise(const std::vector<StepRecord>& steps,
                                        double threshold = 0.9);
