@@ -71,7 +71,7 @@ std::unique_ptr<FrameSource> open_source(const std::string& source, float speed)
   const std::string scheme = "openni2://";
   if (source.rfind(scheme, 0) == 0) {
     const std::string uri = source.substr(scheme.size());
-    return std::make_unique<OpenNi2Source>(uri.empty() ? std::string() : uri, oni);
+    return std::make_unique<OpenNi2Source>(uri, oni);  // empty: the first device
   }
   if (source.size() > 4 && source.compare(source.size() - 4, 4, ".oni") == 0) {
     if (!fs::is_regular_file(source)) {
