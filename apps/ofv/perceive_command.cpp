@@ -128,6 +128,7 @@ Command add_perceive_command(CLI::App& app) {
     double voxel = 0.008;
     double obb_margin = 0.03;
     double max_motion = 0.012;
+    bool no_plane_occluders = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -152,6 +153,8 @@ Command add_perceive_command(CLI::App& app) {
                   "Augmentation of the object's OBB [m] (default 0.03)");
   sub->add_option("--max-motion", opt->max_motion,
                   "Largest object motion between frames [m] (default 0.012)");
+  sub->add_flag("--no-plane-occluders", opt->no_plane_occluders,
+                "The support plane (found in frame 0) is background, not occluders");
   sub->footer(kSourceHelp);
 
   return {sub, [opt]() -> int {
@@ -170,6 +173,7 @@ Command add_perceive_command(CLI::App& app) {
               ps.r_sphere = settings.r_sphere;
               ps.obb_margin = opt->obb_margin;
               ps.tracking.max_motion = opt->max_motion;
+              ps.support_plane_occludes = !opt->no_plane_occluders;
               if (!opt->box.empty()) {
                 const auto b = parse_numbers(opt->box, 6, "--box");
                 ps.selection.mode = ObjectSelection::Mode::Box;

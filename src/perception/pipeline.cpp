@@ -692,6 +692,8 @@ void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& ob
       if (s.normal_valid) {
         vertices.push_back(static_cast<int>(i));
       }
+    } else if (!settings.support_plane_occludes && on_plane(s)) {
+      s.label = SupervoxelClass::Background;
     } else if (r.obb.contains(s.centroid)) {
       s.label = SupervoxelClass::Interacting;
       ++r.counts.interacting;

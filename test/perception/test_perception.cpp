@@ -69,6 +69,30 @@ TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
   }
 }
 
+TEST(Perception, SupportPlaneCanBeLeftOutOfTheOccluders) {
+  const Eigen::Isometry3d wMc = test::front_camera();
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(arm_in_front());
+  PerceptionSettings without;
+  without.support_plane_occludes = false;
+  Perception paper{PerceptionSettings{}};
+  Perception no_table{without};
+  const Frame f = render(scene, wMc);
+  const PerceptionResult a = paper.process(f.frame);
+  const PerceptionResult b = no_table.process(f.frame);
+  ASSERT_EQ(a.status, TrackingStatus::Initialised);
+  ASSERT_EQ(b.status, TrackingStatus::Initialised);
+  const auto ta = test::supervoxel_truth(a, f.frame, f.labels);
+  const auto tb = test::supervoxel_truth(b, f.frame, f.labels);
+  EXPECT_GT(test::count_truth_as(a, ta, kTable, SupervoxelClass::Occluder), 100);
+  // Table supervoxels off the plane fit (the tabletop's edges) may remain.
+  EXPECT_LT(test::count_truth_as(b, tb, kTable, SupervoxelClass::Occluder),
+            test::count_truth_as(a, ta, kTable, SupervoxelClass::Occluder) / 10);
+  EXPECT_EQ(test::count_truth_as(b, tb, kHand, SupervoxelClass::Occluder),
+            test::count_truth_as(a, ta, kHand, SupervoxelClass::Occluder));
+  EXPECT_GE(test::count_truth_as(b, tb, kHand, SupervoxelClass::Occluder), 3);
+}
+
 TEST(Perception, NormalsFaceTheCameraAndAdjacencyRespectsRadius) {
   PerceptionSettings settings;
   Perception perception{settings};

@@ -109,6 +109,12 @@ struct PerceptionSettings {
   /// The object's OBB (PCA of its voxels) grows by this on every side [m]:
   /// what lies inside it but is not object is interacting (a holding hand).
   double obb_margin = 0.03;
+  /// The paper's classification makes every non-object supervoxel inside
+  /// the sphere an occluder (or, inside the OBB, interacting), the table the
+  /// object stands on included. false: supervoxels of the support plane
+  /// found in the first frame are background (as the simulator's
+  /// ground-truth problem, which lists only occluding bodies).
+  bool support_plane_occludes = true;
   ObjectSelection selection;
 };
 
