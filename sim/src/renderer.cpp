@@ -354,7 +354,10 @@ ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double 
 
   std::vector<WorldPoint> occluding;
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
-    if (scenario_.bodies[b].role != Role::Occluder) continue;
+    // Everything but the object and its holder (inside the augmented OBB anyway):
+    // the occluders and the table, as the paper's classification would.
+    const Role role = scenario_.bodies[b].role;
+    if (role != Role::Occluder && role != Role::Background) continue;
     for (const auto& s : impl_->samples[b]) {
       const WorldPoint w = at(impl_->world[b], s);
       if (w.n.dot(o - w.p) <= 0.0) continue;  // the sensor sees only this side

@@ -44,8 +44,8 @@ double positive_number(const std::string& name, const std::string& value) {
 const std::vector<std::string>& episode_setting_names() {
   static const std::vector<std::string> names{
       "method", "sampling_candidates", "sampling_occluder_radius", "controller", "gain",
-      "max_linear_speed", "max_angular_speed", "target_filter", "robot", "perception", "duration",
-      "seed"};
+      "max_linear_speed", "max_angular_speed", "target_filter", "target_hysteresis", "robot",
+      "perception", "duration", "seed"};
   return names;
 }
 
@@ -93,6 +93,11 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
       s.controller.max_angular_speed = positive_number(name, value);
     } else if (name == "target_filter") {
       s.controller.target_filter = value == "0" ? 0.0 : positive_number(name, value);
+    } else if (name == "target_hysteresis") {
+      if (value != "true" && value != "false") {
+        throw std::invalid_argument("setting 'target_hysteresis' must be true or false, got \"" + value + "\"");
+      }
+      s.target_hysteresis = value == "true";
     } else if (name == "robot") {
       if (value != "camera" && value != "viper850" && value != "afma6") {
         throw std::invalid_argument("setting 'robot' must be camera, viper850 or afma6, got \"" + value + "\"");
@@ -155,7 +160,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 #endif
 
   EpisodeOutcome outcome;
-  std::optional<Eigen::Vector3d> previous_view;
+  std::optional<Eigen::Vector3d> previous_view, previous_target;
   for (long k = 0; k < steps; ++k) {
     StepRecord rec;
     rec.time = static_cast<double>(k) * dt;
@@ -217,6 +222,27 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
         case ViewMethod::Static: break;
       }
       previous_view = estimate->tf;
+      if (setup.target_hysteresis && previous_target && target) {
+        if (setup.method == ViewMethod::Estimator) {
+          // Continue from the previous target (the spec's warm start): it stays
+          // where it is while clear and otherwise moves to the nearest clear view.
+          ViewProblem from_previous = *problem;
+          from_previous.previous_view = *previous_target;
+          EstimatorSettings warm = setup.estimator;
+          warm.warm_start = true;
+          const ViewEstimate kept = estimate_view(from_previous, warm);
+          if (kept.status != ViewStatus::NotConverged) target = kept.tf;
+        } else if (setup.method == ViewMethod::Sampling) {
+          // Keep the previous view while it sees as much as the new best.
+          const Eigen::Vector3d previous = estimate->centroid + r_sphere * (*previous_target - estimate->centroid).normalized();
+          const double r = setup.sampling.occluder_radius;
+          if (score_view(*problem, estimate->centroid, r_sphere, previous, r).visible_fraction >=
+              score_view(*problem, estimate->centroid, r_sphere, *target, r).visible_fraction) {
+            target = previous;
+          }
+        }
+      }
+      previous_target = target;
     } else {
       rec.status = "object_lost";
     }

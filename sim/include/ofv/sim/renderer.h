@@ -76,8 +76,9 @@ class Renderer {
    *        supervoxels (the camera-facing surface samples grouped in an
    *        r_seed grid, centroid and normal per cell, normals towards the
    *        camera side), and as occluders the r_seed-grid cells of the
-   *        occluders' surfaces inside the sphere and outside the object's
-   *        augmented OBB (PCA box grown by `obb_margin`).
+   *        camera-facing surfaces of the occluders and the table inside the
+   *        sphere and outside the object's augmented OBB (PCA box grown by
+   *        `obb_margin`), as the paper classifies them.
    */
   [[nodiscard]] ViewProblem ground_truth_problem(const Eigen::Isometry3d& wMc, double r_seed,
                                                  double r_sphere, double obb_margin = 0.03) const;

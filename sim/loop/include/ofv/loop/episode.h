@@ -44,6 +44,14 @@ struct EpisodeSetup {
   std::string robot = "camera";
   PerceptionMode perception = PerceptionMode::GroundTruth;
   double duration = 0.0;  ///< [s]
+  /// Target continuity. Re-estimating from scratch every frame, a symmetric
+  /// occlusion can make the target flip between two sides of an occluder and
+  /// the camera dither between them. With this on, the target the camera
+  /// follows is re-estimated from the previous target (the spec's warm start):
+  /// it stays while clear and otherwise moves to the nearest clear view; the
+  /// sampling planner keeps its previous view while it sees as much as the new
+  /// best. The recorded t0 and tf stay the plain estimator's.
+  bool target_hysteresis = true;
 };
 
 /// \brief Names accepted by resolve_episode() besides the estimator's settings.
@@ -54,7 +62,8 @@ struct EpisodeSetup {
  *        (lengths may be `r_seed` or `r_sphere`, meaning the scenario's
  *        value), `method`, `sampling_candidates`, `sampling_occluder_radius`,
  *        `controller` (law), `gain`, `max_linear_speed`, `max_angular_speed`,
- *        `target_filter`, `robot`, `perception`, `duration`, `seed`.
+ *        `target_filter`, `target_hysteresis` (true/false), `robot`, `perception`,
+ *        `duration`, `seed`.
  * \throws std::invalid_argument naming the setting and the value.
  */
 [[nodiscard]] EpisodeSetup resolve_episode(
