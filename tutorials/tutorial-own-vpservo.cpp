@@ -32,10 +32,10 @@ int main() {
   task.setServo(vpServo::EYEINHAND_CAMERA);
   task.setInteractionMatrixType(vpServo::CURRENT);
   task.addFeature(s, s_star);
-  task.setLambda(2.0);
+  task.setLambda(1.0);
 
   double worst = 0.0;
-  for (int k = 0; k < 150; ++k) {
+  for (int k = 0; k < 300; ++k) {
     const vpHomogeneousMatrix wMc = robot.getPosition();
     s.build(wMc.inverse(), centroid, tf, r_sphere);  // re-set every frame: the target may move
     const vpColVector v = task.computeControlLaw();
