@@ -3,9 +3,12 @@
 
 #include "ofv/estimator.h"
 
+#include "ofv/frame_source.h"
+
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +41,14 @@ Command add_simulate_command(CLI::App& app);
 
 /// Registers `ofv compare` (settings compared in closed loop) on the app.
 Command add_compare_command(CLI::App& app);
+
+/// Opens a frame source: a TUM RGB-D folder, a PCD sequence, a .oni file or
+/// openni2://URI; `speed` is the .oni playback speed. Throws
+/// std::invalid_argument naming the source when it is none of these.
+std::unique_ptr<FrameSource> open_source(const std::string& source, float speed);
+
+/// Registers `ofv run` (the closed loop on a robot and a sensor) on the app.
+Command add_run_command(CLI::App& app);
 
 /// Registers `ofv perceive` (perception front end + estimator over a source) on the app.
 Command add_perceive_command(CLI::App& app);

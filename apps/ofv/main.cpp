@@ -23,6 +23,9 @@ int main(int argc, char** argv) {
 #ifdef OFV_HAVE_PERCEPTION  // built with the perception front end (OFV_BUILD_PERCEPTION)
   commands.push_back(add_perceive_command(app));
 #endif
+#ifdef OFV_HAVE_RUN  // built with the perception front end and the servo library
+  commands.push_back(add_run_command(app));
+#endif
 #ifdef OFV_HAVE_SIM  // built with the simulator (OFV_BUILD_SIM)
   commands.push_back(add_render_command(app));
 #endif

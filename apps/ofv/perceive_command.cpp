@@ -65,6 +65,27 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t count,
   return values;
 }
 
+nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
+  return {{"valid_pixels", c.valid_pixels},
+          {"cropped_points", c.cropped_points},
+          {"voxels", c.voxels},
+          {"supervoxels", c.supervoxels},
+          {"adjacency_edges", c.adjacency_edges},
+          {"object", c.object},
+          {"object_voxels", c.object_voxels},
+          {"hidden_voxels", c.hidden_voxels},
+          {"interacting", c.interacting},
+          {"occluders", c.occluders}};
+}
+
+nlohmann::ordered_json timings_json(const PerceptionTimings& t, double estimate_ms) {
+  return {{"cloud", t.cloud},       {"supervoxels", t.supervoxels}, {"adjacency", t.adjacency},
+          {"tracking", t.tracking}, {"classify", t.classify},       {"front_end", t.total},
+          {"estimate", estimate_ms}};
+}
+
+}  // namespace
+
 std::unique_ptr<FrameSource> open_source(const std::string& source, float speed) {
   OpenNi2Options oni;
   oni.playback_speed = speed;
@@ -93,27 +114,6 @@ std::unique_ptr<FrameSource> open_source(const std::string& source, float speed)
                               ": not a TUM RGB-D directory, a PCD sequence, a .oni file or an "
                               "openni2:// URI");
 }
-
-nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
-  return {{"valid_pixels", c.valid_pixels},
-          {"cropped_points", c.cropped_points},
-          {"voxels", c.voxels},
-          {"supervoxels", c.supervoxels},
-          {"adjacency_edges", c.adjacency_edges},
-          {"object", c.object},
-          {"object_voxels", c.object_voxels},
-          {"hidden_voxels", c.hidden_voxels},
-          {"interacting", c.interacting},
-          {"occluders", c.occluders}};
-}
-
-nlohmann::ordered_json timings_json(const PerceptionTimings& t, double estimate_ms) {
-  return {{"cloud", t.cloud},       {"supervoxels", t.supervoxels}, {"adjacency", t.adjacency},
-          {"tracking", t.tracking}, {"classify", t.classify},       {"front_end", t.total},
-          {"estimate", estimate_ms}};
-}
-
-}  // namespace
 
 Command add_perceive_command(CLI::App& app) {
   struct Options {
