@@ -8,6 +8,8 @@
 #include <random>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace ofv {
 namespace {
 
@@ -46,7 +48,8 @@ class Compare : public testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("ofv_compare_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("ofv_compare_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) +
+            "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
