@@ -74,6 +74,7 @@ nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
           {"object", c.object},
           {"object_voxels", c.object_voxels},
           {"hidden_voxels", c.hidden_voxels},
+          {"hidden_vertices", c.hidden_vertices},
           {"interacting", c.interacting},
           {"occluders", c.occluders}};
 }

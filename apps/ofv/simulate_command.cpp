@@ -232,9 +232,16 @@ Command add_simulate_command(CLI::App& app) {
                         << (setup.perception == PerceptionMode::Full ? "full" : "ground-truth") << '\n'
                         << "  visible fraction: mean " << m.mean_visible_fraction << ", min "
                         << m.min_visible_fraction << ", below 0.9 for " << m.time_below_threshold << " s\n"
-                        << "  occlusions: " << m.occlusions.size() << ", worst recovery "
-                        << (m.max_recovery_time ? std::to_string(*m.max_recovery_time) + " s" : std::string("never"))
-                        << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path "
+                        << "  occlusions (visible < 0.9): " << m.occlusions.size();
+              if (!m.occlusions.empty()) {
+                std::cout << ", worst recovery ";
+                if (m.max_recovery_time) {
+                  std::cout << *m.max_recovery_time << " s";
+                } else {
+                  std::cout << "never (" << m.unrecovered_occlusions << " still hidden at the end)";
+                }
+              }
+              std::cout << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path "
                         << m.path_length << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
                         << "  compute per step: " << 1e3 * m.mean_times.total() << " ms (render "
                         << 1e3 * m.mean_times.render << ", perception " << 1e3 * m.mean_times.perception

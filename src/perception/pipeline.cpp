@@ -136,6 +136,21 @@ std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eigen::Isom
   return Eigen::Vector2d(k.fx * pc.x() / pc.z() + k.cx, k.fy * pc.y() / pc.z() + k.cy);
 }
 
+/// True when world point p cannot be seen in the frame: out of the image, or
+/// behind a surface nearer the camera by more than `tolerance` [m].
+bool hidden(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
+            double tolerance) {
+  double z = 0.0;
+  const auto px = project(frame, cMw, p, &z);
+  if (!px) return true;
+  const int u = static_cast<int>(std::lround(px->x()));
+  const int v = static_cast<int>(std::lround(px->y()));
+  const CameraIntrinsics& k = frame.intrinsics;
+  if (u < 0 || v < 0 || u >= k.width || v >= k.height) return true;
+  const float observed = frame.depth[frame.index(u, v)];
+  return std::isfinite(observed) && observed > 0.0f && static_cast<double>(observed) < z - tolerance;
+}
+
 /// Colour without brightness: R, G, B over their sum (shading-invariant).
 Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) { return rgb / std::max(rgb.sum(), 1.0f); }
 
@@ -243,6 +258,11 @@ struct Perception::Impl {
   std::vector<Eigen::Vector3f> memory;  // object voxels: seen now, or hidden behind something
   std::vector<Eigen::Vector3f> memory_chroma;  // chromaticity of each memory voxel
   std::vector<int> memory_age;                 // frames since the voxel was last seen
+  struct Vertex {
+    Eigen::Vector3d centroid, normal;
+    int age = 0;  // frames since it was last seen
+  };
+  std::vector<Vertex> vertex_memory;  // object supervoxels: seen now, or hidden behind something
   std::size_t initial_voxels = 0;              // object voxels in the first frame (seen whole)
   std::optional<Eigen::Vector4d> plane;        // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
@@ -600,27 +620,10 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
     }
   }
   const Eigen::Isometry3d cMw = frame.wMc.inverse();
-  const CameraIntrinsics& k = frame.intrinsics;
   const double tolerance = settings.tracking.max_motion;
+  const int max_age = settings.tracking.occlusion_memory_frames;
   for (std::size_t i = 0; i < memory.size(); ++i) {
-    if (memory_age[i] + 1 > settings.tracking.occlusion_memory_frames) {
-      continue;
-    }
-    double z = 0.0;
-    const auto px = project(frame, cMw, memory[i].cast<double>(), &z);
-    bool hidden = !px;
-    if (px) {
-      const int u = static_cast<int>(std::lround(px->x()));
-      const int v = static_cast<int>(std::lround(px->y()));
-      if (u < 0 || v < 0 || u >= k.width || v >= k.height) {
-        hidden = true;
-      } else {
-        const float observed = frame.depth[frame.index(u, v)];
-        hidden = std::isfinite(observed) && observed > 0.0f &&
-                 static_cast<double>(observed) < z - tolerance;
-      }
-    }
-    if (hidden) {
+    if (memory_age[i] + 1 <= max_age && hidden(frame, cMw, memory[i].cast<double>(), tolerance)) {
       next.push_back(memory[i]);
       next_chroma.push_back(memory_chroma[i]);
       next_age.push_back(memory_age[i] + 1);
@@ -629,6 +632,24 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
   memory.swap(next);
   memory_chroma.swap(next_chroma);
   memory_age.swap(next_age);
+
+  // The same for the object's supervoxels (the estimator's vertices). A
+  // remembered vertex goes when it shows again or a seen one takes its place.
+  std::vector<Vertex> vertices;
+  for (std::size_t i = 0; i < r.supervoxels.size(); ++i) {
+    if (object[i] && r.supervoxels[i].normal_valid) {
+      vertices.push_back({r.supervoxels[i].centroid, r.supervoxels[i].normal, 0});
+    }
+  }
+  const std::size_t seen = vertices.size();
+  const double spacing = 0.5 * settings.supervoxels.seed_resolution;
+  for (const Vertex& m : vertex_memory) {
+    if (m.age + 1 > max_age || !hidden(frame, cMw, m.centroid, tolerance)) continue;
+    const bool replaced = std::any_of(vertices.begin(), vertices.begin() + static_cast<std::ptrdiff_t>(seen),
+                                      [&](const Vertex& v) { return (v.centroid - m.centroid).norm() < spacing; });
+    if (!replaced) vertices.push_back({m.centroid, m.normal, m.age + 1});
+  }
+  vertex_memory.swap(vertices);
 }
 
 void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& object) {
@@ -713,6 +734,24 @@ void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& ob
     p.positions.col(static_cast<Eigen::Index>(j)) = s.centroid;
     p.normals.col(static_cast<Eigen::Index>(j)) = s.normal;
   }
+  if (settings.tracking.hidden_vertices) {
+    // The object's remembered supervoxels now hidden: the estimator keeps
+    // them in view too, not only the part that is still seen.
+    Eigen::Index k = p.positions.cols();
+    for (const Vertex& m : vertex_memory) {
+      k += m.age > 0 ? 1 : 0;
+    }
+    p.positions.conservativeResize(3, k);
+    p.normals.conservativeResize(3, k);
+    k = static_cast<Eigen::Index>(vertices.size());
+    for (const Vertex& m : vertex_memory) {
+      if (m.age == 0) continue;
+      p.positions.col(k) = m.centroid;
+      p.normals.col(k) = m.normal;
+      ++k;
+    }
+    r.counts.hidden_vertices = static_cast<std::size_t>(k) - vertices.size();
+  }
   p.occluders.resize(3, static_cast<Eigen::Index>(occluders.size()));
   for (std::size_t j = 0; j < occluders.size(); ++j) {
     p.occluders.col(static_cast<Eigen::Index>(j)) =
@@ -738,6 +777,7 @@ void Perception::reset() {
   impl_->memory.clear();
   impl_->memory_chroma.clear();
   impl_->memory_age.clear();
+  impl_->vertex_memory.clear();
   impl_->initial_voxels = 0;
   impl_->plane.reset();
 }

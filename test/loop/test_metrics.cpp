@@ -43,16 +43,43 @@ TEST(Metrics, AnOcclusionThatNeverClearsIsUnrecovered) {
   const EpisodeMetrics m = summarise(steps);
   ASSERT_EQ(m.occlusions.size(), 1U);
   EXPECT_FALSE(m.occlusions[0].recovery_time);
+  EXPECT_NEAR(*m.occlusions[0].occluder_entered, 0.1, 1e-12);
   EXPECT_EQ(m.unrecovered_occlusions, 1);
   EXPECT_FALSE(m.max_recovery_time);
 }
 
-TEST(Metrics, AnOccluderThatDoesNotHideRecoversAtOnce) {
+TEST(Metrics, AnOccluderThatDoesNotHideIsNoEvent) {
   const auto steps = episode({1.0, 1.0, 1.0}, {0, 1, 0});
   const EpisodeMetrics m = summarise(steps);
-  ASSERT_EQ(m.occlusions.size(), 1U);
-  EXPECT_EQ(*m.occlusions[0].recovery_time, 0.0);
+  EXPECT_TRUE(m.occlusions.empty());
+  EXPECT_EQ(*m.max_recovery_time, 0.0);
   EXPECT_EQ(m.time_below_threshold, 0.0);
+}
+
+TEST(Metrics, DipsCloserThanTheHoldAreOneEvent) {
+  // Occluder enters at 0.1 s; hidden 0.3-0.4, back for 0.1 s only, hidden at
+  // 0.6, back for good from 0.7; a later dip at 1.2 s is a second event.
+  const std::vector<double> v{1, 1, 1, 0.5, 0.5, 0.95, 0.5, 1, 1, 1, 1, 1, 0.8, 1, 1};
+  std::vector<int> occ(v.size(), 1);
+  occ[0] = 0;
+  const EpisodeMetrics m = summarise(episode(v, occ), 0.9, 0.2);
+  ASSERT_EQ(m.occlusions.size(), 2U);
+  EXPECT_NEAR(m.occlusions[0].onset, 0.3, 1e-12);
+  EXPECT_NEAR(*m.occlusions[0].recovery_time, 0.4, 1e-12);
+  EXPECT_NEAR(*m.occlusions[0].occluder_entered, 0.1, 1e-12);
+  EXPECT_NEAR(m.occlusions[1].onset, 1.2, 1e-12);
+  EXPECT_NEAR(*m.occlusions[1].recovery_time, 0.1, 1e-12);
+  EXPECT_NEAR(*m.max_recovery_time, 0.4, 1e-12);
+  // With no hold, each dip is an event of its own.
+  EXPECT_EQ(summarise(episode(v, occ), 0.9, 0.0).occlusions.size(), 3U);
+}
+
+TEST(Metrics, HiddenFromTheStartWithoutAnEntryHasNoWarning) {
+  const EpisodeMetrics m = summarise(episode({0.3, 0.3, 1.0}, {1, 1, 1}));
+  ASSERT_EQ(m.occlusions.size(), 1U);
+  EXPECT_NEAR(m.occlusions[0].onset, 0.0, 1e-12);
+  EXPECT_NEAR(*m.occlusions[0].recovery_time, 0.2, 1e-12);
+  EXPECT_FALSE(m.occlusions[0].occluder_entered);
 }
 
 TEST(Metrics, EmptyAndSingleStepEpisodes) {

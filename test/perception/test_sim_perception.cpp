@@ -143,6 +143,48 @@ TEST(SimPerception, MovingObject) {
   EXPECT_GT(s.frames_with_occluder_in_sphere, 0);
 }
 
+// While the hand covers part of the case, the hidden part's remembered
+// supervoxels stay in the estimator's problem: each lies on the case and
+// behind the hand (its pixel shows the hand). Without the setting the
+// problem holds only what the frame shows.
+TEST(SimPerception, HiddenObjectSupervoxelsStayInTheProblem) {
+  const sim::Scenario scenario = sim::load_scenario("dvd-one-hand");
+  sim::Renderer renderer(scenario);
+  PerceptionSettings with;
+  PerceptionSettings without;
+  without.tracking.hidden_vertices = false;
+  Perception a(with), b(without);
+  const Eigen::Isometry3d cMw = scenario.wMc_start.inverse();
+  std::size_t most_hidden = 0;
+  for (int k = 0; k < static_cast<int>(2.3 * scenario.rate); ++k) {
+    renderer.set_time(k / scenario.rate);
+    const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
+    const PerceptionResult ra = a.process(rendered.frame);
+    const PerceptionResult rb = b.process(rendered.frame);
+    ASSERT_NE(ra.status, TrackingStatus::Lost);
+    ASSERT_NE(rb.status, TrackingStatus::Lost);
+    EXPECT_EQ(rb.counts.hidden_vertices, 0U);
+    const auto seen = static_cast<std::size_t>(std::count_if(
+        rb.supervoxels.begin(), rb.supervoxels.end(),
+        [](const SupervoxelInfo& s) { return s.label == SupervoxelClass::Object && s.normal_valid; }));
+    EXPECT_EQ(static_cast<std::size_t>(rb.problem.positions.cols()), seen);
+    const auto n = static_cast<Eigen::Index>(ra.counts.hidden_vertices);
+    ASSERT_EQ(ra.problem.normals.cols(), ra.problem.positions.cols());
+    most_hidden = std::max(most_hidden, ra.counts.hidden_vertices);
+    for (Eigen::Index j = ra.problem.positions.cols() - n; j < ra.problem.positions.cols(); ++j) {
+      const Eigen::Vector3d p = ra.problem.positions.col(j);
+      EXPECT_LT(std::abs(p.z() - 0.5), 0.02) << "a remembered vertex off the case: " << p.transpose();
+      const Eigen::Vector3d pc = cMw * p;
+      const CameraIntrinsics& in = rendered.frame.intrinsics;
+      const auto u = static_cast<int>(std::lround(in.fx * pc.x() / pc.z() + in.cx));
+      const auto v = static_cast<int>(std::lround(in.fy * pc.y() / pc.z() + in.cy));
+      ASSERT_TRUE(u >= 0 && v >= 0 && u < in.width && v < in.height);
+      EXPECT_GE(rendered.labels[rendered.frame.index(u, v)], sim::kLabelOccluder0) << "not behind the hand";
+    }
+  }
+  EXPECT_GE(most_hidden, 5U) << "the hand should hide several of the case's supervoxels";
+}
+
 TEST(SimPerception, RecordedEpisodesPlayBackThroughPerceive) {
   for (const std::string format : {"oni", "tum", "pcd"}) {
     const std::string out = (std::filesystem::path(testing::TempDir()) /

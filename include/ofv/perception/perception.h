@@ -72,6 +72,11 @@ struct TrackingSettings {
   /// for this many frames, so the occluded part is recognised when it
   /// reappears [frames].
   int occlusion_memory_frames = 60;
+  /// The object's supervoxels hidden behind something nearer the camera
+  /// (remembered as above) stay vertices of the estimator's problem, so the
+  /// view keeps the whole object clear, not only the part still seen.
+  /// false: only the supervoxels seen in the frame (the paper's reading).
+  bool hidden_vertices = true;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
   /// this distance, normal within 60 degrees) are never object: the table
@@ -162,6 +167,7 @@ struct PerceptionCounts {
   std::size_t occluders = 0;
   std::size_t object_voxels = 0;  ///< seen in this frame
   std::size_t hidden_voxels = 0;  ///< remembered behind occluders, added to the object cloud
+  std::size_t hidden_vertices = 0;  ///< remembered object supervoxels added to the problem (hidden_vertices)
 };
 
 /// \brief Wall time of each stage [ms].

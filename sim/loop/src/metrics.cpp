@@ -25,7 +25,7 @@ std::vector<double> step_durations(const std::vector<StepRecord>& steps) {
 
 }  // namespace
 
-EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold) {
+EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold, double hold) {
   EpisodeMetrics m;
   m.visibility_threshold = threshold;
   m.steps = static_cast<int>(steps.size());
@@ -77,34 +77,31 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold)
   m.mean_times.control /= n;
   m.status_counts.assign(statuses.begin(), statuses.end());
 
-  // Occlusion events: the ground-truth count of occluders in the sphere rises.
-  // An event lasts until the next one (or the end); it has recovered once the
-  // visibility is back at or above the threshold for the rest of it.
-  std::vector<std::size_t> onsets;
-  for (std::size_t k = 1; k < steps.size(); ++k) {
-    if (steps[k].occluders_in_sphere > steps[k - 1].occluders_in_sphere) onsets.push_back(k);
-  }
-  for (std::size_t e = 0; e < onsets.size(); ++e) {
-    const std::size_t begin = onsets[e];
-    const std::size_t end = e + 1 < onsets.size() ? onsets[e + 1] : steps.size();
+  // Occlusion events: the visibility falls below the threshold, until it is
+  // back for `hold` seconds.
+  std::optional<double> entered;  // the occluder count's last rise
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    if (k > 0 && steps[k].occluders_in_sphere > steps[k - 1].occluders_in_sphere) entered = steps[k].time;
+    if (steps[k].visible_fraction >= threshold) continue;
     OcclusionEvent event;
-    event.onset = steps[begin].time;
-    std::size_t last_below = begin;
-    bool dropped = false;
-    for (std::size_t j = begin; j < end; ++j) {
+    event.onset = steps[k].time;
+    event.occluder_entered = entered;
+    std::size_t j = k + 1;  // the first step of a visible run that lasts `hold`
+    while (j < steps.size()) {
       if (steps[j].visible_fraction < threshold) {
-        last_below = j;
-        dropped = true;
+        ++j;
+        continue;
       }
+      std::size_t next_dip = j;
+      while (next_dip < steps.size() && steps[next_dip].visible_fraction >= threshold) ++next_dip;
+      if (next_dip == steps.size() || steps[next_dip].time - steps[j].time >= hold) break;
+      j = next_dip;
     }
-    if (!dropped) {
-      event.recovery_time = 0.0;
-    } else if (last_below + 1 < end) {
-      event.recovery_time = steps[last_below + 1].time - event.onset;
-    } else if (end < steps.size()) {
-      event.recovery_time = std::nullopt;  // still hidden when the next occluder came
-    }
+    if (j < steps.size()) event.recovery_time = steps[j].time - event.onset;
     m.occlusions.push_back(event);
+    for (; k + 1 < j && k + 1 < steps.size(); ++k) {  // the rises inside the event still count
+      if (steps[k + 1].occluders_in_sphere > steps[k].occluders_in_sphere) entered = steps[k + 1].time;
+    }
   }
   double worst = 0.0;
   for (const auto& e : m.occlusions) {

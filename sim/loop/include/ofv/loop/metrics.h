@@ -42,10 +42,14 @@ struct StepRecord {
   StageTimes times;                   ///< compute time of this step
 };
 
-/// \brief One occlusion event: an occluder entered the sphere.
+/// \brief One occlusion event: the visible fraction fell below the threshold.
 struct OcclusionEvent {
-  double onset = 0.0;                   ///< time the occluder count rose [s]
-  std::optional<double> recovery_time;  ///< time until visibility stays >= threshold [s]; none if never
+  double onset = 0.0;                   ///< time the visibility fell below the threshold [s]
+  std::optional<double> recovery_time;  ///< from the onset until it is back for good [s]; none if never
+  /// When the occluder count in the sphere last rose, at or before the onset
+  /// [s]: the warning the loop had. None when no occluder entered (one was
+  /// there from the start, or the object left the image).
+  std::optional<double> occluder_entered;
 };
 
 /// \brief Summary of an episode.
@@ -75,13 +79,13 @@ struct EpisodeMetrics {
  * \param steps  records in time order, one per frame period.
  * \param threshold  visibility counted as "in view" [0, 1].
  * Each step stands for the interval until the next one (the last for the
- * mean period). An occlusion event runs from an onset (the occluder count
- * rises) to the next onset or the end; its recovery time is from the onset
- * to the step after which visibility stays >= threshold for the rest of the
- * event (0 when it never dropped, none when it is still below at the end).
+ * mean period). An occlusion event starts when the visibility falls below
+ * `threshold` and ends at the first step from which it stays at or above the
+ * threshold for `hold` seconds (or to the end): dips closer together than
+ * that are one event. Its recovery time runs from the fall to that step.
  */
 [[nodiscard]] EpisodeMetrics summarise(const std::vector<StepRecord>& steps,
-                                       double threshold = 0.9);
+                                       double threshold = 0.9, double hold = 0.2);
 
 /// \brief Header line of trajectory.csv.
 [[nodiscard]] std::string trajectory_csv_header();
