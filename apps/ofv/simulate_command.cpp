@@ -150,7 +150,7 @@ Command add_simulate_command(CLI::App& app) {
                   "ground-truth (default; this build has no perception front end) or full"
 #endif
   );
-  sub->add_option("--seed", opt->seed, "Seed added to the scenario's (sensor noise)")->capture_default_str();
+  sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
   sub->add_option("--out", opt->out, "Output folder (default: out/simulate/SCENARIO)");
   sub->add_flag("!--no-pictures", opt->pictures, "Skip the PNG pictures");
   std::string list;
@@ -175,7 +175,7 @@ Command add_simulate_command(CLI::App& app) {
               settings.emplace_back("perception", opt->perception.empty() ? "ground-truth" : opt->perception);
 #endif
               if (opt->seed < 0) throw std::invalid_argument("--seed must be >= 0");
-              settings.emplace_back("seed", std::to_string(scenario.seed + static_cast<unsigned>(opt->seed)));
+              settings.emplace_back("seed", std::to_string(opt->seed));
               setup = resolve_episode(scenario, settings);
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv simulate: " << e.what() << '\n';

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -268,8 +269,8 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
     throw std::invalid_argument(source + ": invalid YAML: " + e.what());
   }
   const Node top(root, source, "");
-  top.require_map({"description", "duration", "rate", "seed", "sensor", "camera", "object", "holder",
-                   "occluders", "table", "estimator", "robot", "controller"});
+  top.require_map({"description", "duration", "rate", "seed", "variation", "sensor", "camera", "object",
+                   "holder", "occluders", "table", "estimator", "robot", "controller"});
   Scenario s;
   s.path = source;
   s.name = fs::path(source).stem().string();
@@ -277,6 +278,12 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
   if (top.has("duration")) s.duration = top.child("duration").positive();
   if (top.has("rate")) s.rate = top.child("rate").positive();
   if (top.has("seed")) s.seed = static_cast<unsigned>(top.child("seed").integer(0));
+  if (top.has("variation")) {
+    const Node n = top.child("variation");
+    n.require_map({"time", "position"});
+    if (n.has("time")) s.variation.time = n.child("time").in_range(0.0, 1e3);
+    if (n.has("position")) s.variation.position = n.child("position").in_range(0.0, 10.0);
+  }
 
   s.sensor.intrinsics = intrinsics_preset("fast-320");
   if (top.has("sensor")) {
@@ -397,6 +404,27 @@ std::vector<std::string> builtin_scenarios() {
   }
   std::sort(names.begin(), names.end());
   return names;
+}
+
+Scenario with_seed(const Scenario& scenario, unsigned k) {
+  Scenario s = scenario;
+  s.seed = scenario.seed + k;
+  if (k == 0) return s;
+  std::mt19937_64 rng((static_cast<std::uint64_t>(scenario.seed) << 32) ^ (0x5DEECE66Dull * k));
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (Body& b : s.bodies) {
+    if (b.role != Role::Occluder) continue;
+    const double delay = s.variation.time * uniform(rng);
+    Eigen::Vector3d shift;
+    do {
+      shift = Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+    } while (shift.squaredNorm() > 1.0);
+    for (Waypoint& w : b.motion.waypoints) {
+      w.t += delay;
+      w.position += s.variation.position * shift;
+    }
+  }
+  return s;
 }
 
 Scenario load_scenario(const std::string& path_or_name) {

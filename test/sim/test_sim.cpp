@@ -65,6 +65,8 @@ TEST(Scenario, ErrorsNameFileKeyAndValue) {
       {"object: {shape: box}\ncamera: {position: [0, 0, 0], look_at: [0, 0, 0]}", {"camera"}},
       {"object: {shape: box, wave: {amplitude: 0.1}}", {"object.wave", "cloth"}},
       {"object: [1, 2", {"invalid YAML"}},
+      {"object: {shape: box}\nvariation: {time: -1}", {"variation.time", "-1"}},
+      {"object: {shape: box}\nvariation: {speed: 1}", {"variation.speed", "unknown key"}},
   };
   for (const auto& [yaml, mentions] : cases) {
     const std::string message = error_of(yaml);
@@ -85,6 +87,50 @@ TEST(Scenario, BuiltInScenariosLoad) {
     for (const auto& b : s.bodies) EXPECT_TRUE(b.mesh.valid()) << n << " " << b.name;
   }
   EXPECT_THROW((void)load_scenario("no-such-scenario"), std::invalid_argument);
+}
+
+TEST(Scenario, SeedsVaryTheOccludersWithinTheScenarioVariation) {
+  const Scenario base = load_scenario("dvd-two-hands");
+  ASSERT_GT(base.variation.time, 0.0);
+  ASSERT_GT(base.variation.position, 0.0);
+  const Scenario same = with_seed(base, 0);
+  EXPECT_EQ(same.seed, base.seed);
+  const auto waypoints_equal = [](const Body& a, const Body& b) {
+    if (a.motion.waypoints.size() != b.motion.waypoints.size()) return false;
+    for (std::size_t i = 0; i < a.motion.waypoints.size(); ++i) {
+      if (a.motion.waypoints[i].t != b.motion.waypoints[i].t ||
+          a.motion.waypoints[i].position != b.motion.waypoints[i].position) {
+        return false;
+      }
+    }
+    return true;
+  };
+  int moved = 0;
+  for (unsigned k = 0; k < 4; ++k) {
+    const Scenario s = with_seed(base, k);
+    EXPECT_EQ(s.seed, base.seed + k);
+    const Scenario again = with_seed(base, k);
+    for (std::size_t b = 0; b < base.bodies.size(); ++b) {
+      const Body& before = base.bodies[b];
+      const Body& after = s.bodies[b];
+      EXPECT_TRUE(waypoints_equal(after, again.bodies[b])) << "seed " << k << " is not reproducible";
+      if (k == 0 || before.role != Role::Occluder) {
+        EXPECT_TRUE(waypoints_equal(before, after)) << "seed " << k << " changed " << before.name;
+        continue;
+      }
+      moved += waypoints_equal(before, after) ? 0 : 1;
+      // One delay and one shift for the whole motion, within the bounds.
+      const double delay = after.motion.waypoints[0].t - before.motion.waypoints[0].t;
+      const Eigen::Vector3d shift = after.motion.waypoints[0].position - before.motion.waypoints[0].position;
+      EXPECT_LE(std::abs(delay), base.variation.time + 1e-12);
+      EXPECT_LE(shift.norm(), base.variation.position + 1e-12);
+      for (std::size_t i = 0; i < before.motion.waypoints.size(); ++i) {
+        EXPECT_NEAR(after.motion.waypoints[i].t - before.motion.waypoints[i].t, delay, 1e-12);
+        EXPECT_TRUE((after.motion.waypoints[i].position - before.motion.waypoints[i].position).isApprox(shift, 1e-12));
+      }
+    }
+  }
+  EXPECT_EQ(moved, 6) << "seeds 1-3 should move both hands";
 }
 
 TEST(Motion, InterpolatesPositionLinearlyAndRotationBySlerp) {

@@ -122,7 +122,7 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
         used = 0;
       }
       if (used != value.size() || seed < 0) throw std::invalid_argument("setting 'seed' must be a non-negative integer, got \"" + value + "\"");
-      s.scenario.seed = static_cast<unsigned>(seed);
+      s.scenario = sim::with_seed(scenario, static_cast<unsigned>(seed));
     } else {
       std::string list;
       for (const auto& n : estimator_names) list += (list.empty() ? "" : ", ") + n;
@@ -274,11 +274,10 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 
 EpisodeRunner simulation_runner() {
   return [](const EpisodeSpec& spec) {
-    const sim::Scenario scenario = sim::load_scenario(spec.scenario_path);
     auto settings = spec.variant.settings;
     // Seed k of a scenario is the same world for every variant.
-    settings.emplace_back("seed", std::to_string(scenario.seed + static_cast<unsigned>(spec.seed)));
-    return run_episode(resolve_episode(scenario, settings));
+    settings.emplace_back("seed", std::to_string(spec.seed));
+    return run_episode(resolve_episode(sim::load_scenario(spec.scenario_path), settings));
   };
 }
 

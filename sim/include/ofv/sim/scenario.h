@@ -77,6 +77,12 @@ struct SensorSettings {
 /// \brief Intrinsics presets: `d435-640` (640x480, D435-like) and `fast-320` (320x240).
 [[nodiscard]] CameraIntrinsics intrinsics_preset(const std::string& name);
 
+/// \brief How much the occluders' motion changes from one seed to the next.
+struct Variation {
+  double time = 0.0;      ///< each occluder's motion is delayed by a draw in [-time, time] [s]
+  double position = 0.0;  ///< and moved by a draw in the ball of this radius [m]
+};
+
 /// \brief A whole scenario.
 struct Scenario {
   std::string name;       ///< file stem
@@ -84,6 +90,7 @@ struct Scenario {
   double duration = 4.0;  ///< [s]
   double rate = 30.0;     ///< sensor rate [Hz]
   unsigned seed = 1;      ///< sensor noise seed (frame k uses seed and k)
+  Variation variation;    ///< what with_seed() draws for seeds other than 0
   SensorSettings sensor;
   Eigen::Isometry3d wMc_start = Eigen::Isometry3d::Identity();  ///< camera start pose
   std::vector<Body> bodies;  ///< the object first
@@ -97,6 +104,14 @@ struct Scenario {
 /// \brief Parses a scenario from YAML text; `source` names it in errors.
 /// \throws std::invalid_argument naming the file, the key and the value.
 [[nodiscard]] Scenario scenario_from_yaml(const std::string& text, const std::string& source);
+
+/**
+ * \brief The scenario's k-th random world: the sensor noise seed becomes
+ *        seed + k and, for k > 0, every occluder's motion is shifted in time
+ *        and space by draws within `variation` (from seed and k only, so the
+ *        same for every setting). k = 0 is the scenario as written.
+ */
+[[nodiscard]] Scenario with_seed(const Scenario& scenario, unsigned k);
 
 /// \brief Loads a scenario file, or a built-in scenario by name (e.g. `dvd-one-hand`).
 [[nodiscard]] Scenario load_scenario(const std::string& path_or_name);

@@ -63,7 +63,7 @@ struct EpisodeSetup {
  *        value), `method`, `sampling_candidates`, `sampling_occluder_radius`,
  *        `controller` (law), `gain`, `max_linear_speed`, `max_angular_speed`,
  *        `target_filter`, `target_hysteresis` (true/false), `robot`, `perception`,
- *        `duration`, `seed`.
+ *        `duration`, `seed` (k: the scenario's k-th random world, see sim::with_seed).
  * \throws std::invalid_argument naming the setting and the value.
  */
 [[nodiscard]] EpisodeSetup resolve_episode(
