@@ -1,9 +1,15 @@
 // The whole simulated closed-loop step (render 320x240 + perception + estimate
 // + control + robot step) on the default scenario: steps per second over
-// one-second episodes (>= 30 keeps up with the sensor).
+// one-second episodes (>= 30 keeps up with the sensor); and the throughput of
+// `ofv compare` in episodes per minute.
+#include "ofv/loop/compare.h"
 #include "ofv/loop/episode.h"
 
 #include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <filesystem>
+#include <unistd.h>
 
 namespace {
 
@@ -26,5 +32,39 @@ void BM_ClosedLoopStep(benchmark::State& state) {
   state.SetItemsProcessed(steps);  // items_per_second: closed-loop steps per second
 }
 BENCHMARK(BM_ClosedLoopStep)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// ofv compare's harness on 4 built-in scenarios x 2 seeds of 2-second
+// episodes, the paper's settings. Args: jobs, perception (0 ground truth, 1 full).
+void BM_CompareThroughput(benchmark::State& state) {
+  const int jobs = static_cast<int>(state.range(0));
+  std::vector<std::pair<std::string, std::string>> scenarios;
+  for (const char* name : {"dvd-one-hand", "dvd-two-hands", "cloth-occluder", "sweep"}) {
+    scenarios.emplace_back(name, ofv::sim::builtin_scenario_dir() + "/" + name + ".yaml");
+  }
+  ofv::Grid grid;
+  grid.seeds = 2;
+  grid.variants = {{"paper", {{"perception", state.range(1) ? "full" : "ground-truth"}, {"duration", "2.0"}}}};
+  const auto episodes = ofv::plan_episodes(scenarios, grid);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("ofv_bench_compare_" + std::to_string(::getpid()));
+  ofv::SweepOptions options;
+  options.jobs = jobs;
+  long done = 0;
+  double seconds = 0.0;
+  for (auto _ : state) {
+    std::filesystem::remove_all(dir);  // a fresh sweep, nothing to resume
+    const auto start = std::chrono::steady_clock::now();
+    done += ofv::run_sweep(episodes, ofv::simulation_runner(), dir.string(), options);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  std::filesystem::remove_all(dir);
+  state.counters["episodes_per_min"] = 60.0 * static_cast<double>(done) / seconds;
+}
+BENCHMARK(BM_CompareThroughput)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"jobs", "full"})
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 }  // namespace
