@@ -119,7 +119,7 @@ bool plot_visibility(const fs::path& dir) {
      << "'\nset datafile separator ','\nset grid\nset xlabel 'time [s]'\nset ylabel 'visible fraction'\n"
         "set y2label 'distance to the sphere [cm]'\nset ytics nomirror\nset y2tics\nset yrange [0:1.05]\n"
         "set key bottom right\nplot '" << (dir / "trajectory.csv").string()
-     << "' using 1:23 every ::1 with lines lw 2 title 'true visible fraction', '' using 1:($25*100) every ::1 axes x1y2 with lines title 'distance error [cm]'\n";
+     << "' using \"time\":\"visible_fraction\" with lines lw 2 title 'true visible fraction', '' using \"time\":(100*column(\"sphere_distance_error\")) axes x1y2 with lines title 'distance error [cm]'\n";
   gp.close();
   return std::system(("gnuplot '" + script.string() + "' 2>/dev/null").c_str()) == 0;
 }

@@ -538,7 +538,7 @@ std::vector<std::string> write_reports(const std::vector<EpisodeRow>& rows,
       if (g.scenario != scenario) continue;
       const EpisodeRow* r = g.rows.front();
       script << (first ? "" : ", ") << gp(r->trajectory_csv)
-             << " using 1:23 every ::1 with lines lw 2 title " << gp(g.variant->name) << " noenhanced";
+             << " using \"time\":\"visible_fraction\" with lines lw 2 title " << gp(g.variant->name) << " noenhanced";
       first = false;
     }
     script << "\nset yrange [*:*]\n";

@@ -243,6 +243,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
         }
       }
       previous_target = target;
+      rec.target = target;
     } else {
       rec.status = "object_lost";
     }

@@ -116,7 +116,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
 }
 
 std::string trajectory_csv_header() {
-  return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,status,iterations,"
+  return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,targetx,targety,targetz,status,iterations,"
          "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,"
          "render_s,perception_s,estimate_s,control_s";
 }
@@ -138,6 +138,7 @@ std::string trajectory_csv_row(const StepRecord& s) {
   for (int k = 0; k < 6; ++k) out << s.velocity(k) << ',';
   vec(s.t0);
   vec(s.tf);
+  vec(s.target);
   out << s.status << ',' << s.iterations << ',' << s.visible_fraction << ','
       << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
       << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','

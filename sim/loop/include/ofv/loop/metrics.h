@@ -33,6 +33,7 @@ struct StepRecord {
   Eigen::Matrix<double, 6, 1> velocity = Eigen::Matrix<double, 6, 1>::Zero();  ///< commanded (v, w), camera frame [m/s, rad/s]
   std::optional<Eigen::Vector3d> t0;  ///< estimator's initial view (none when no estimate)
   std::optional<Eigen::Vector3d> tf;  ///< estimator's final view
+  std::optional<Eigen::Vector3d> target;  ///< the view the controller drove to (after hysteresis, or a baseline's)
   std::string status;                 ///< estimator status, or "object_lost", "static" ...
   int iterations = 0;                 ///< estimator push steps
   double visible_fraction = 0.0;      ///< true fraction of the object surface seen [0, 1]
