@@ -123,6 +123,9 @@ TEST(Interval95, StudentT) {
   EXPECT_DOUBLE_EQ(i.mean, 2.0);
   EXPECT_NEAR(i.half_width, 4.303 * 1.0 / std::sqrt(3.0), 1e-9);
   EXPECT_EQ(mean_interval({std::nan(""), 4.0}).n, 1);
+  // Equal up to rounding (2.1 - 1.7666... vs 2.4333... - 2.1): no interval.
+  EXPECT_EQ(mean_interval({2.1 - 53.0 / 30.0, 73.0 / 30.0 - 2.1}).half_width, 0.0);
+  EXPECT_GT(mean_interval({0.3, 0.3 + 1e-9}).half_width, 0.0);
 }
 
 TEST_F(Compare, ResultsDoNotDependOnTheJobCount) {
