@@ -135,6 +135,7 @@ Command add_simulate_command(CLI::App& app) {
     std::string out;
     int seed = 0;
     bool pictures = true;
+    bool real_time = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("simulate", "Run the closed loop in simulation: render, perceive, estimate, servo");
@@ -153,6 +154,9 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
   sub->add_option("--out", opt->out, "Output folder (default: out/simulate/SCENARIO)");
   sub->add_flag("!--no-pictures", opt->pictures, "Skip the PNG pictures");
+  sub->add_flag("--real-time", opt->real_time,
+                "Run the arm on ViSP's threaded simulator (vpSimulatorViper850/Afma6) in wall-clock time: a "
+                "real-time demo, not exactly repeatable (needs --robot viper850 or afma6)");
   std::string list;
   for (const auto& n : sim::builtin_scenarios()) list += (list.empty() ? "" : ", ") + n;
   sub->footer("Built-in scenarios: " + list + "\nWrites trajectory.csv, metrics.json and pictures (camera views and "
@@ -169,6 +173,7 @@ Command add_simulate_command(CLI::App& app) {
                 settings.emplace_back(a.substr(0, eq), a.substr(eq + 1));
               }
               if (!opt->robot.empty()) settings.emplace_back("robot", opt->robot);
+              if (opt->real_time) settings.emplace_back("real_time", "true");
 #ifdef OFV_HAVE_PERCEPTION
               settings.emplace_back("perception", opt->perception.empty() ? "full" : opt->perception);
 #else

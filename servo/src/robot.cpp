@@ -9,6 +9,13 @@
 #include <visp3/robot/vpRobot.h>
 #include <visp3/robot/vpViper850.h>
 
+#if defined(VISP_HAVE_MODULE_GUI) && defined(VISP_HAVE_PTHREAD)
+#include <visp3/robot/vpSimulatorAfma6.h>
+#include <visp3/robot/vpSimulatorViper850.h>
+#define OFV_HAVE_THREADED_SIMULATORS
+#endif
+
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -63,17 +70,21 @@ struct KinematicArm::Impl {
   [[nodiscard]] vpColVector qmax() const { return model == Model::Viper850 ? viper.getJointMax() : afma.getJointMax(); }
 };
 
+vpColVector KinematicArm::start_joints(Model model) {
+  vpColVector q(6, 0.0);
+  if (model == Model::Viper850) {
+    q[1] = -1.2;
+    q[2] = 2.6;
+    q[4] = -1.4;
+  } else {
+    q[4] = 0.4;
+  }
+  return q;
+}
+
 KinematicArm::KinematicArm(Model model, const vpHomogeneousMatrix& wMc_start) : impl_(std::make_unique<Impl>()) {
   impl_->model = model;
-  // A start configuration away from singularities and limits, camera forward.
-  q_.resize(6, true);
-  if (model == Model::Viper850) {
-    q_[1] = -1.2;
-    q_[2] = 2.6;
-    q_[4] = -1.4;
-  } else {
-    q_[4] = 0.4;
-  }
+  q_ = start_joints(model);
   // Place the base so that this configuration puts the camera at wMc_start.
   wMf_ = wMc_start * impl_->fMc(q_).inverse();
 }
@@ -107,30 +118,95 @@ RobotStep KinematicArm::step(const vpColVector& v, double dt) {
   return r;
 }
 
-VispRobot::VispRobot(vpRobot& robot, const vpHomogeneousMatrix& fMw, std::string name)
-    : robot_(robot), wMf_(fMw.inverse()), name_(std::move(name)) {
+VispRobot::VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name)
+    : robot_(robot), fMc_(std::move(fMc)), wMf_(fMw.inverse()), name_(std::move(name)) {
   robot_.setRobotState(vpRobot::STATE_VELOCITY_CONTROL);
 }
 
-vpHomogeneousMatrix VispRobot::wMc() const {
-  vpColVector p;
-  robot_.getPosition(vpRobot::REFERENCE_FRAME, p);
-  return wMf_ * vpHomogeneousMatrix(vpPoseVector(p[0], p[1], p[2], p[3], p[4], p[5]));
-}
+vpHomogeneousMatrix VispRobot::wMc() const { return wMf_ * fMc_(); }
 
 RobotStep VispRobot::step(const vpColVector& v, double dt) {
-  const double start = vpTime::measureTimeMs();
   robot_.setVelocity(vpRobot::CAMERA_FRAME, usable(v, dt) ? v : vpColVector(6, 0.0));
-  vpTime::wait(start, 1000.0 * dt);
+  // Keep the cadence: this period ends one dt after the previous one did;
+  // after an overrun, at once.
+  const double now = vpTime::measureTimeMs();
+  next_ms_ = std::max(now, (next_ms_ < 0.0 ? now : next_ms_) + 1000.0 * dt);
+  vpTime::wait(next_ms_ - now);
   return {wMc(), false};
 }
 
 void VispRobot::stop() { robot_.setVelocity(vpRobot::CAMERA_FRAME, vpColVector(6, 0.0)); }
 
-std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start) {
-  if (name == "camera") return std::make_unique<FreeFlyingCamera>(wMc_start);
-  if (name == "viper850") return std::make_unique<KinematicArm>(KinematicArm::Model::Viper850, wMc_start);
-  if (name == "afma6") return std::make_unique<KinematicArm>(KinematicArm::Model::Afma6, wMc_start);
+#if defined(OFV_HAVE_THREADED_SIMULATORS)
+namespace {
+// A threaded simulator whose joints can be set at once (the public
+// setPosition() moves there in wall-clock time).
+template <class Simulator>
+struct Placed : Simulator {
+  Placed() : Simulator(false) {}
+  void place(const vpColVector& q) {
+    this->set_artCoord(q);
+    this->compute_fMi();
+  }
+};
+}  // namespace
+
+struct ThreadedArm::Impl {
+  std::unique_ptr<vpRobot> simulator;
+  std::unique_ptr<VispRobot> robot;
+  std::string name;
+};
+
+ThreadedArm::ThreadedArm(KinematicArm::Model model, const vpHomogeneousMatrix& wMc_start)
+    : impl_(std::make_unique<Impl>()) {
+  // The simulator, headless, started in KinematicArm's start configuration.
+  const vpColVector q0 = KinematicArm::start_joints(model);
+  auto make = [&](auto simulator, const char* name) {
+    simulator->place(q0);
+    simulator->setMaxTranslationVelocity(2.0);  // [m/s]; the controller's limits bind first
+    simulator->setMaxRotationVelocity(4.0);     // [rad/s]
+    vpPoseVector p;
+    simulator->getPosition(vpRobot::REFERENCE_FRAME, p);
+    const vpHomogeneousMatrix fMw = vpHomogeneousMatrix(p) * wMc_start.inverse();
+    impl_->robot = std::make_unique<VispRobot>(*simulator, fMw, name);
+    impl_->simulator = std::move(simulator);
+    impl_->name = name;
+  };
+  if (model == KinematicArm::Model::Viper850) {
+    make(std::make_unique<Placed<vpSimulatorViper850>>(), "viper850-threaded");
+  } else {
+    make(std::make_unique<Placed<vpSimulatorAfma6>>(), "afma6-threaded");
+  }
+}
+
+ThreadedArm::~ThreadedArm() {
+  if (impl_ && impl_->robot) impl_->robot->stop();
+}
+vpHomogeneousMatrix ThreadedArm::wMc() const { return impl_->robot->wMc(); }
+RobotStep ThreadedArm::step(const vpColVector& v, double dt) { return impl_->robot->step(v, dt); }
+std::string ThreadedArm::name() const { return impl_->name; }
+#else
+struct ThreadedArm::Impl {};
+ThreadedArm::ThreadedArm(KinematicArm::Model, const vpHomogeneousMatrix&) {
+  throw std::runtime_error("this ViSP has no threaded robot simulators (needs its gui module and pthreads)");
+}
+ThreadedArm::~ThreadedArm() = default;
+vpHomogeneousMatrix ThreadedArm::wMc() const { return {}; }
+RobotStep ThreadedArm::step(const vpColVector&, double) { return {}; }
+std::string ThreadedArm::name() const { return {}; }
+#endif
+
+std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start,
+                                        bool real_time) {
+  if (name == "camera") {
+    if (real_time) throw std::invalid_argument("robot 'camera' has no real-time simulator (use viper850 or afma6)");
+    return std::make_unique<FreeFlyingCamera>(wMc_start);
+  }
+  if (name == "viper850" || name == "afma6") {
+    const auto model = name == "viper850" ? KinematicArm::Model::Viper850 : KinematicArm::Model::Afma6;
+    if (real_time) return std::make_unique<ThreadedArm>(model, wMc_start);
+    return std::make_unique<KinematicArm>(model, wMc_start);
+  }
   throw std::invalid_argument("unknown robot '" + name + "' (expected camera, viper850, afma6)");
 }
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <visp3/core/vpExponentialMap.h>
 
+#include <chrono>
 #include <random>
 
 namespace ofv {
@@ -142,6 +143,33 @@ TEST(Robots, FollowAConstantTwist) {
     EXPECT_FALSE(step.limited) << name;
   }
   EXPECT_THROW((void)make_robot("puma560", start), std::invalid_argument);
+}
+
+// ViSP's threaded simulator, driven in wall-clock time, against its
+// kinematic twin: same start, same commands, same motion. A rotation-heavy
+// twist, so that reading the pose in the wrong rotation convention would show.
+TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
+  const vpHomogeneousMatrix start = looking_at({0.1, -0.05, 0}, {0, 0, 0.5});
+  for (const auto model : {KinematicArm::Model::Viper850, KinematicArm::Model::Afma6}) {
+    ThreadedArm threaded(model, start);
+    KinematicArm twin(model, start);
+    EXPECT_TRUE(to_eigen(threaded.wMc()).isApprox(to_eigen(start), 1e-6)) << threaded.name();
+    const vpColVector v{0.04, 0.0, 0.02, 0.0, 0.3, 0.15};
+    const double dt = 1.0 / 30.0;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < 15; ++k) {
+      (void)threaded.step(v, dt);
+      (void)twin.step(v, dt);
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_GE(elapsed, 15 * dt - 0.02) << "one period of wall-clock time per step";
+    const Eigen::Isometry3d a = to_eigen(threaded.wMc()), b = to_eigen(twin.wMc());
+    EXPECT_LT((a.translation() - b.translation()).norm(), 0.015) << threaded.name();
+    EXPECT_LT(Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle(), 3.0 * kPi / 180.0) << threaded.name();
+    EXPECT_GT(Eigen::AngleAxisd(to_eigen(start).linear().transpose() * b.linear()).angle(), 5.0 * kPi / 180.0)
+        << "the twin should have turned";
+  }
+  EXPECT_THROW((void)make_robot("camera", start, /*real_time=*/true), std::invalid_argument);
 }
 
 TEST(Robots, JointLimitsClamp) {

@@ -39,12 +39,19 @@ double positive_number(const std::string& name, const std::string& value) {
   return v;
 }
 
+bool boolean(const std::string& name, const std::string& value) {
+  if (value != "true" && value != "false") {
+    throw std::invalid_argument("setting '" + name + "' must be true or false, got \"" + value + "\"");
+  }
+  return value == "true";
+}
+
 }  // namespace
 
 const std::vector<std::string>& episode_setting_names() {
   static const std::vector<std::string> names{
       "method", "sampling_candidates", "sampling_occluder_radius", "controller", "gain",
-      "max_linear_speed", "max_angular_speed", "target_filter", "target_hysteresis", "robot",
+      "max_linear_speed", "max_angular_speed", "target_filter", "target_hysteresis", "robot", "real_time",
       "perception", "duration", "seed"};
   return names;
 }
@@ -94,10 +101,9 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
     } else if (name == "target_filter") {
       s.controller.target_filter = value == "0" ? 0.0 : positive_number(name, value);
     } else if (name == "target_hysteresis") {
-      if (value != "true" && value != "false") {
-        throw std::invalid_argument("setting 'target_hysteresis' must be true or false, got \"" + value + "\"");
-      }
-      s.target_hysteresis = value == "true";
+      s.target_hysteresis = boolean(name, value);
+    } else if (name == "real_time") {
+      s.real_time = boolean(name, value);
     } else if (name == "robot") {
       if (value != "camera" && value != "viper850" && value != "afma6") {
         throw std::invalid_argument("setting 'robot' must be camera, viper850 or afma6, got \"" + value + "\"");
@@ -132,6 +138,9 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
   }
   s.estimator = params.resolve();
   validate(s.controller);
+  if (s.real_time && s.robot == "camera") {
+    throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");
+  }
   return s;
 }
 
@@ -143,7 +152,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   const double r_seed = setup.estimator.r_seed;
 
   sim::Renderer renderer(scenario);
-  std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start));
+  std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
   ViewController controller(setup.controller);
 #ifdef OFV_LOOP_HAVE_PERCEPTION
   std::unique_ptr<Perception> perception;

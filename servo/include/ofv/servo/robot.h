@@ -7,8 +7,9 @@
  *   deterministic.
  * - KinematicArm on ViSP's kinematic models of the Viper850 (6-axis arm) and
  *   the Afma6 (gantry): q̇ = (cVe eJe)^+ v, integrated over dt, clamped to the
- *   joint limits; faster than real time and deterministic (the threaded
- *   vpSimulatorViper850/Afma6 integrate in wall-clock time: RealtimeRobot).
+ *   joint limits; faster than real time and deterministic.
+ * - ThreadedArm: ViSP's threaded vpSimulatorViper850/Afma6, in wall-clock
+ *   time (real-time demos).
  * - VispRobot: any ViSP vpRobot driver (real or threaded simulator) through
  *   setVelocity(CAMERA_FRAME) and its measured pose.
  *
@@ -19,11 +20,12 @@
 
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
+#include <visp3/core/vpPoseVector.h>
+#include <visp3/robot/vpRobot.h>
 
+#include <functional>
 #include <memory>
 #include <string>
-
-class vpRobot;
 
 namespace ofv {
 
@@ -62,6 +64,8 @@ class KinematicArm : public CameraRobot {
   enum class Model { Viper850, Afma6 };
   /// \param wMc_start camera start pose; the base is placed to match it.
   KinematicArm(Model model, const vpHomogeneousMatrix& wMc_start);
+  /// \brief The start configuration: away from singularities and joint limits, camera forward.
+  [[nodiscard]] static vpColVector start_joints(Model model);
   ~KinematicArm() override;
   [[nodiscard]] vpHomogeneousMatrix wMc() const override;
   RobotStep step(const vpColVector& v, double dt) override;
@@ -83,14 +87,26 @@ class KinematicArm : public CameraRobot {
  * \brief Any ViSP robot (a real driver such as vpRobotViper850, vpRobotAfma6,
  *        vpRobotFranka, vpRobotUniversalRobots, or a threaded simulator),
  *        commanded in the camera frame. step() sends the velocity with
- *        setVelocity(CAMERA_FRAME), lets dt elapse on the wall clock
- *        (vpTime::wait) and reads the camera pose back with
- *        getPosition(REFERENCE_FRAME) (ViSP's drivers report the camera
- *        frame there once their tool/eMc is set); `fMw` places the world.
+ *        setVelocity(CAMERA_FRAME) and waits until one period after the
+ *        previous step began (vpTime::wait), so that the loop keeps the frame
+ *        rate whatever its compute time; the camera pose is read back with
+ *        getPosition(REFERENCE_FRAME, vpPoseVector&) (θu: the vpColVector
+ *        overload gives Rxyz angles on ViSP's arms). `fMw` places the world.
  */
 class VispRobot : public CameraRobot {
  public:
-  VispRobot(vpRobot& robot, const vpHomogeneousMatrix& fMw, std::string name);
+  /// \brief Reads the camera pose in the robot's reference frame, fMc.
+  using PoseReader = std::function<vpHomogeneousMatrix()>;
+  /// \brief `Driver`: any vpRobot with getPosition(vpRobot::REFERENCE_FRAME, vpPoseVector&).
+  template <class Driver>
+  VispRobot(Driver& robot, const vpHomogeneousMatrix& fMw, std::string name)
+      : VispRobot(static_cast<vpRobot&>(robot), PoseReader([&robot] {
+                    vpPoseVector p;
+                    robot.getPosition(vpRobot::REFERENCE_FRAME, p);
+                    return vpHomogeneousMatrix(p);
+                  }),
+                  fMw, std::move(name)) {}
+  VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name);
   [[nodiscard]] vpHomogeneousMatrix wMc() const override;
   RobotStep step(const vpColVector& v, double dt) override;
   [[nodiscard]] std::string name() const override { return name_; }
@@ -99,14 +115,40 @@ class VispRobot : public CameraRobot {
 
  private:
   vpRobot& robot_;
+  PoseReader fMc_;
   vpHomogeneousMatrix wMf_;
   std::string name_;
+  double next_ms_ = -1.0;  // when the current period ends (vpTime::measureTimeMs)
 };
 
 /**
- * \brief `camera` (FreeFlyingCamera), `viper850` or `afma6` (KinematicArm).
- * \throws std::invalid_argument naming an unknown robot.
+ * \brief ViSP's threaded simulators, vpSimulatorViper850 and vpSimulatorAfma6
+ *        (headless), through VispRobot: they integrate in wall-clock time, so
+ *        an episode runs in real time and is not exactly repeatable. For
+ *        demos; KinematicArm is the deterministic twin. The arm starts in
+ *        KinematicArm::start_joints(), its base placed so that the camera is
+ *        at `wMc_start`.
  */
-[[nodiscard]] std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start);
+class ThreadedArm : public CameraRobot {
+ public:
+  /// \throws std::runtime_error when this ViSP has no threaded simulators.
+  ThreadedArm(KinematicArm::Model model, const vpHomogeneousMatrix& wMc_start);
+  ~ThreadedArm() override;  ///< stops the arm
+  [[nodiscard]] vpHomogeneousMatrix wMc() const override;
+  RobotStep step(const vpColVector& v, double dt) override;
+  [[nodiscard]] std::string name() const override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/**
+ * \brief `camera` (FreeFlyingCamera), `viper850` or `afma6` (KinematicArm,
+ *        or ThreadedArm when `real_time`).
+ * \throws std::invalid_argument naming an unknown robot, or `camera` in real time.
+ */
+[[nodiscard]] std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start,
+                                                      bool real_time = false);
 
 }  // namespace ofv

@@ -52,6 +52,9 @@ struct EpisodeSetup {
   /// sampling planner keeps its previous view while it sees as much as the new
   /// best. The recorded t0 and tf stay the plain estimator's.
   bool target_hysteresis = true;
+  /// The arms on ViSP's threaded simulators (ThreadedArm), one frame period
+  /// of wall-clock time per step: a real-time demo, not exactly repeatable.
+  bool real_time = false;
 };
 
 /// \brief Names accepted by resolve_episode() besides the estimator's settings.
@@ -62,7 +65,8 @@ struct EpisodeSetup {
  *        (lengths may be `r_seed` or `r_sphere`, meaning the scenario's
  *        value), `method`, `sampling_candidates`, `sampling_occluder_radius`,
  *        `controller` (law), `gain`, `max_linear_speed`, `max_angular_speed`,
- *        `target_filter`, `target_hysteresis` (true/false), `robot`, `perception`,
+ *        `target_filter`, `target_hysteresis` (true/false), `robot`, `real_time`
+ *        (true/false), `perception`,
  *        `duration`, `seed` (k: the scenario's k-th random world, see sim::with_seed).
  * \throws std::invalid_argument naming the setting and the value.
  */
