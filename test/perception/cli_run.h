@@ -1,6 +1,8 @@
 // Test helper: runs the `ofv` binary and captures its exit code, stdout and stderr.
 #pragma once
 
+#include "scratch.h"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -23,7 +25,7 @@ struct CommandRun {
 /// Runs `ofv ARGS` (OFV_BINARY) through the shell.
 inline CommandRun run(const std::string& args) {
   const std::filesystem::path err =
-      std::filesystem::path(testing::TempDir()) / "ofv_cli_stderr.txt";
+      std::filesystem::path(test::scratch_dir()) / "ofv_cli_stderr.txt";
   const std::string command = std::string(OFV_BINARY) + " " + args + " 2>" + err.string();
   CommandRun r;
   FILE* pipe = popen(command.c_str(), "r");

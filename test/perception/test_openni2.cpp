@@ -2,6 +2,7 @@
 // player (libOniFile), the DummyDevice driver, and errors.
 #include "ofv/sources/openni2_source.h"
 
+#include "scratch.h"
 #include "synthetic_scene.h"
 
 #include <gtest/gtest.h>
@@ -29,7 +30,7 @@ std::vector<RgbdFrame> moving_case(int frames) {
 }
 
 std::string write_oni(const std::string& name, const std::vector<RgbdFrame>& frames) {
-  const fs::path path = fs::path(testing::TempDir()) / name;
+  const fs::path path = fs::path(test::scratch_dir()) / name;
   OniWriter writer(path.string());
   for (const RgbdFrame& f : frames) {
     writer.write(f);
@@ -91,7 +92,7 @@ TEST(OpenNi2, DepthOnlyRecording) {
 
 TEST(OpenNi2, WriterRejectsInconsistentFrames) {
   const auto frames = moving_case(1);
-  OniWriter writer((fs::path(testing::TempDir()) / "ofv_perception_bad.oni").string());
+  OniWriter writer((fs::path(test::scratch_dir()) / "ofv_perception_bad.oni").string());
   writer.write(frames[0]);
   RgbdFrame other = frames[0];
   other.rgb.clear();
@@ -103,14 +104,14 @@ TEST(OpenNi2, WriterRejectsInconsistentFrames) {
 }
 
 TEST(OpenNi2, MissingOrBrokenFilesAreErrorsNamingThePath) {
-  const std::string missing = (fs::path(testing::TempDir()) / "ofv_no_such.oni").string();
+  const std::string missing = (fs::path(test::scratch_dir()) / "ofv_no_such.oni").string();
   try {
     OpenNi2Source source(missing);
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(missing), std::string::npos);
   }
-  const std::string broken = (fs::path(testing::TempDir()) / "ofv_broken.oni").string();
+  const std::string broken = (fs::path(test::scratch_dir()) / "ofv_broken.oni").string();
   std::ofstream(broken) << "this is not an OpenNI recording";
   try {
     OpenNi2Source source(broken);

@@ -39,8 +39,8 @@ std::vector<RgbdFrame> episode() {
 }
 
 TEST(PerceiveCli, TumSequenceGivesProblemsForOfvEstimateAndPictures) {
-  const fs::path dir = fs::path(testing::TempDir()) / "ofv_perceive_tum";
-  const fs::path out = fs::path(testing::TempDir()) / "ofv_perceive_out";
+  const fs::path dir = fs::path(test::scratch_dir()) / "ofv_perceive_tum";
+  const fs::path out = fs::path(test::scratch_dir()) / "ofv_perceive_out";
   fs::remove_all(dir);
   fs::remove_all(out);
   {
@@ -77,7 +77,7 @@ TEST(PerceiveCli, TumSequenceGivesProblemsForOfvEstimateAndPictures) {
 }
 
 TEST(PerceiveCli, OniRecordingStreamsJsonLines) {
-  const fs::path oni = fs::path(testing::TempDir()) / "ofv_perceive.oni";
+  const fs::path oni = fs::path(test::scratch_dir()) / "ofv_perceive.oni";
   {
     OniWriter writer(oni.string());
     for (const RgbdFrame& f : episode()) {
@@ -102,8 +102,8 @@ TEST(PerceiveCli, BadInputIsExitTwoWithOneLine) {
   for (const std::string& args :
        {std::string("perceive /no/such/dir"), std::string("perceive /no/such/file.oni"),
         std::string("perceive openni2://no-such-device"),
-        std::string("perceive ") + testing::TempDir() + " --box 1,2,3",
-        std::string("perceive ") + testing::TempDir() + " --pictures"}) {
+        std::string("perceive ") + test::scratch_dir() + " --box 1,2,3",
+        std::string("perceive ") + test::scratch_dir() + " --pictures"}) {
     const CommandRun r = run(args);
     EXPECT_EQ(r.code, 2) << args;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;

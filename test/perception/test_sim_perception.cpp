@@ -187,7 +187,7 @@ TEST(SimPerception, HiddenObjectSupervoxelsStayInTheProblem) {
 
 TEST(SimPerception, RecordedEpisodesPlayBackThroughPerceive) {
   for (const std::string format : {"oni", "tum", "pcd"}) {
-    const std::string out = (std::filesystem::path(testing::TempDir()) /
+    const std::string out = (std::filesystem::path(test::scratch_dir()) /
                              ("ofv_record_" + format + (format == "oni" ? ".oni" : "")))
                                 .string();
     std::filesystem::remove_all(out);

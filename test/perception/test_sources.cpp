@@ -3,6 +3,7 @@
 #include "ofv/sources/pcd_sequence.h"
 #include "ofv/sources/tum_sequence.h"
 
+#include "scratch.h"
 #include "synthetic_scene.h"
 
 #include <gtest/gtest.h>
@@ -17,7 +18,7 @@ namespace {
 
 /// A fresh directory under the test's temporary directory.
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / ("ofv_perception_" + name);
+  const fs::path dir = fs::path(test::scratch_dir()) / ("ofv_perception_" + name);
   fs::remove_all(dir);
   return dir;
 }
