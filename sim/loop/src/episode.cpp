@@ -232,9 +232,10 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
       }
       previous_view = estimate->tf;
       if (setup.target_hysteresis && previous_target && target) {
-        if (setup.method == ViewMethod::Estimator) {
-          // Continue from the previous target (the spec's warm start): it stays
-          // where it is while clear and otherwise moves to the nearest clear view.
+        if (setup.method == ViewMethod::Estimator && estimate->iterations > 0) {
+          // t0 is occluded: continue from the previous target (the spec's warm
+          // start), which stays where it is while clear and otherwise moves to
+          // the nearest clear view. While t0 is clear, t0 is the target.
           ViewProblem from_previous = *problem;
           from_previous.previous_view = *previous_target;
           EstimatorSettings warm = setup.estimator;

@@ -46,9 +46,10 @@ struct EpisodeSetup {
   double duration = 0.0;  ///< [s]
   /// Target continuity. Re-estimating from scratch every frame, a symmetric
   /// occlusion can make the target flip between two sides of an occluder and
-  /// the camera dither between them. With this on, the target the camera
-  /// follows is re-estimated from the previous target (the spec's warm start):
-  /// it stays while clear and otherwise moves to the nearest clear view; the
+  /// the camera dither between them. With this on, while t0 is occluded the
+  /// target the camera follows is re-estimated from the previous target (the
+  /// spec's warm start): it stays while clear and otherwise moves to the
+  /// nearest clear view; once t0 is clear again, t0 is the target. The
   /// sampling planner keeps its previous view while it sees as much as the new
   /// best. The recorded t0 and tf stay the plain estimator's.
   bool target_hysteresis = true;
