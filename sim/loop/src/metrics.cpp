@@ -77,15 +77,18 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
   m.mean_times.control /= n;
   m.status_counts.assign(statuses.begin(), statuses.end());
 
+  // When the occluder count in the sphere last rose, at or before each step.
+  std::vector<std::optional<double>> entered(steps.size());
+  for (std::size_t k = 1; k < steps.size(); ++k) {
+    entered[k] = steps[k].occluders_in_sphere > steps[k - 1].occluders_in_sphere ? steps[k].time : entered[k - 1];
+  }
   // Occlusion events: the visibility falls below the threshold, until it is
   // back for `hold` seconds.
-  std::optional<double> entered;  // the occluder count's last rise
   for (std::size_t k = 0; k < steps.size(); ++k) {
-    if (k > 0 && steps[k].occluders_in_sphere > steps[k - 1].occluders_in_sphere) entered = steps[k].time;
     if (steps[k].visible_fraction >= threshold) continue;
     OcclusionEvent event;
     event.onset = steps[k].time;
-    event.occluder_entered = entered;
+    event.occluder_entered = entered[k];
     std::size_t j = k + 1;  // the first step of a visible run that lasts `hold`
     while (j < steps.size()) {
       if (steps[j].visible_fraction < threshold) {
@@ -99,9 +102,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
     }
     if (j < steps.size()) event.recovery_time = steps[j].time - event.onset;
     m.occlusions.push_back(event);
-    for (; k + 1 < j && k + 1 < steps.size(); ++k) {  // the rises inside the event still count
-      if (steps[k + 1].occluders_in_sphere > steps[k].occluders_in_sphere) entered = steps[k + 1].time;
-    }
+    k = j - 1;  // on from the recovery
   }
   double worst = 0.0;
   for (const auto& e : m.occlusions) {
