@@ -1,7 +1,6 @@
 // Robots: free-flying camera, kinematic Viper850/Afma6, any vpRobot.
 #include "ofv/servo/robot.h"
 
-#include <visp3/core/vpExponentialMap.h>
 #include <visp3/core/vpPoseVector.h>
 #include <visp3/core/vpTime.h>
 #include <visp3/core/vpVelocityTwistMatrix.h>
@@ -33,11 +32,19 @@ bool usable(const vpColVector& v, double dt) {
 
 }  // namespace
 
-FreeFlyingCamera::FreeFlyingCamera(const vpHomogeneousMatrix& wMc) : wMc_(wMc) {}
+FreeFlyingCamera::FreeFlyingCamera(const vpHomogeneousMatrix& wMc) {
+  camera_.setMaxTranslationVelocity(1e6);  // ViSP's defaults (0.2 m/s, 0.7 rad/s) would clip the command
+  camera_.setMaxRotationVelocity(1e6);
+  camera_.setPosition(wMc);
+  camera_.setRobotState(vpRobot::STATE_VELOCITY_CONTROL);
+}
 
 RobotStep FreeFlyingCamera::step(const vpColVector& v, double dt) {
-  if (usable(v, dt)) wMc_ = wMc_ * vpExponentialMap::direct(v, dt);
-  return {wMc_, false};
+  if (usable(v, dt) && dt > 0.0) {
+    camera_.setSamplingTime(dt);
+    camera_.setVelocity(vpRobot::CAMERA_FRAME, v);
+  }
+  return {wMc(), false};
 }
 
 // The two ViSP models share get_fMc, get_eJe, get_cVe and the joint limits.

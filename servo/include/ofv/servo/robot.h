@@ -3,8 +3,8 @@
  * \brief Eye-in-hand robots as the closed loop sees them: take a camera
  *        twist for one frame period, report the new camera pose.
  *
- * - FreeFlyingCamera: integrates the twist exactly (like vpSimulatorCamera),
- *   deterministic.
+ * - FreeFlyingCamera: ViSP's vpSimulatorCamera (the twist integrated
+ *   exactly over dt), deterministic.
  * - KinematicArm on ViSP's kinematic models of the Viper850 (6-axis arm) and
  *   the Afma6 (gantry): q̇ = (cVe eJe)^+ v, integrated over dt, clamped to the
  *   joint limits; faster than real time and deterministic.
@@ -22,6 +22,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpPoseVector.h>
 #include <visp3/robot/vpRobot.h>
+#include <visp3/robot/vpSimulatorCamera.h>
 
 #include <functional>
 #include <memory>
@@ -46,16 +47,17 @@ class CameraRobot {
   [[nodiscard]] virtual std::string name() const = 0;
 };
 
-/// \brief A free-flying camera, integrated exactly with vpExponentialMap.
+/// \brief A free-flying camera: vpSimulatorCamera, stepped by dt with no speed
+///        limit of its own (the controller and the safety filter bound it).
 class FreeFlyingCamera : public CameraRobot {
  public:
   explicit FreeFlyingCamera(const vpHomogeneousMatrix& wMc);
-  [[nodiscard]] vpHomogeneousMatrix wMc() const override { return wMc_; }
+  [[nodiscard]] vpHomogeneousMatrix wMc() const override { return camera_.getPosition(); }
   RobotStep step(const vpColVector& v, double dt) override;
   [[nodiscard]] std::string name() const override { return "camera"; }
 
  private:
-  vpHomogeneousMatrix wMc_;
+  vpSimulatorCamera camera_;
 };
 
 /// \brief A ViSP arm model (vpViper850 or vpAfma6) stepped on its kinematics.
