@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -51,7 +52,8 @@ cv::Mat camera_picture(const StepRecord& rec, const StepDetail& d) {
 
 // A Fig. 6-style view of the scene from a virtual observer beside the camera:
 // object supervoxels and normals (blue), occluders (red), the sphere, C, the
-// real camera and its path (white), t0 (yellow) and tf (green).
+// real camera and its path (white), t0 (yellow), tf (green) and, where
+// target hysteresis kept another, the target the controller follows (magenta).
 cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d,
                       const std::vector<Eigen::Vector3d>& path, double r_sphere) {
   const Eigen::Vector3d c = d.estimate ? d.estimate->centroid : d.true_centroid;
@@ -103,6 +105,7 @@ cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d,
   if (d.estimate) {
     mark(d.estimate->t0, {0, 220, 255}, "t0");
     mark(d.estimate->tf, {80, 220, 80}, "tf");
+    if ((d.target - d.estimate->tf).norm() > 1e-3) mark(d.target, {220, 80, 220}, "target");
   }
   std::ostringstream text;
   text << std::fixed << std::setprecision(2) << "t=" << rec.time << " s   visible " << rec.visible_fraction
@@ -136,6 +139,7 @@ Command add_simulate_command(CLI::App& app) {
     int seed = 0;
     bool pictures = true;
     bool real_time = false;
+    bool video = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("simulate", "Run the closed loop in simulation: render, perceive, estimate, servo");
@@ -154,13 +158,15 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
   sub->add_option("--out", opt->out, "Output folder (default: out/simulate/SCENARIO)");
   sub->add_flag("!--no-pictures", opt->pictures, "Skip the PNG pictures");
+  sub->add_flag("--video", opt->video, "Also write episode.avi: the scene view and the camera's view, frame by frame (MJPEG)");
   sub->add_flag("--real-time", opt->real_time,
                 "Run the arm on ViSP's threaded simulator (vpSimulatorViper850/Afma6) in wall-clock time: a "
                 "real-time demo, not exactly repeatable (needs --robot viper850 or afma6)");
   std::string list;
   for (const auto& n : sim::builtin_scenarios()) list += (list.empty() ? "" : ", ") + n;
   sub->footer("Built-in scenarios: " + list + "\nWrites trajectory.csv, metrics.json and pictures (camera views and "
-              "scene views at the start, at each occlusion onset, 1 s later and at the end; visibility.png).");
+              "scene views at the start, when an occluder enters the sphere or the visibility falls below 0.9, 1 s later "
+              "and at the end; visibility.png); with --video, episode.avi.");
 
   return {sub, [opt]() -> int {
             EpisodeSetup setup;
@@ -195,18 +201,37 @@ Command add_simulate_command(CLI::App& app) {
               std::vector<std::string> pictures;
               long index = 0, picture_at = 0;
               int last_occluders = 0;
+              double last_visible = 1.0;
+              cv::VideoWriter video;
+              if (opt->video) {
+                const fs::path file = dir / "episode.avi";
+                video.open(file.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), setup.scenario.rate, {1280, 480});
+                if (!video.isOpened()) throw std::runtime_error("cannot write the video " + file.string());
+              }
               const auto observer = [&](const StepRecord& rec, const StepDetail& d) {
                 path.push_back(rec.wMc.translation());
-                const bool onset = rec.occluders_in_sphere > last_occluders;
+                // Key moments: an occluder enters the sphere, the visibility falls below 0.9.
+                const bool onset = rec.occluders_in_sphere > last_occluders || (rec.visible_fraction < 0.9 && last_visible >= 0.9);
                 last_occluders = rec.occluders_in_sphere;
+                last_visible = rec.visible_fraction;
                 if (onset) picture_at = index + static_cast<long>(setup.scenario.rate);  // 1 s later
-                if (opt->pictures && (index == 0 || onset || index == picture_at || index == total - 1)) {
-                  char name[64];
-                  std::snprintf(name, sizeof name, "t%05.2f", rec.time);
-                  cv::imwrite((dir / (std::string("camera_") + name + ".png")).string(), camera_picture(rec, d));
-                  cv::imwrite((dir / (std::string("scene_") + name + ".png")).string(),
-                              scene_picture(rec, d, path, setup.estimator.r_sphere));
-                  pictures.push_back(std::string("scene_") + name + ".png");
+                const bool picture = opt->pictures && (index == 0 || onset || index == picture_at || index == total - 1);
+                if (picture || opt->video) {
+                  const cv::Mat camera = camera_picture(rec, d);
+                  const cv::Mat scene = scene_picture(rec, d, path, setup.estimator.r_sphere);
+                  if (picture) {
+                    char name[64];
+                    std::snprintf(name, sizeof name, "t%05.2f", rec.time);
+                    cv::imwrite((dir / (std::string("camera_") + name + ".png")).string(), camera);
+                    cv::imwrite((dir / (std::string("scene_") + name + ".png")).string(), scene);
+                    pictures.push_back(std::string("scene_") + name + ".png");
+                  }
+                  if (opt->video) {
+                    cv::Mat frame(480, 1280, CV_8UC3);
+                    scene.copyTo(frame(cv::Rect(0, 0, 640, 480)));
+                    cv::resize(camera, frame(cv::Rect(640, 0, 640, 480)), {640, 480});
+                    video.write(frame);
+                  }
                 }
                 ++index;
                 if (tty) {
@@ -252,7 +277,7 @@ Command add_simulate_command(CLI::App& app) {
                         << 1e3 * m.mean_times.render << ", perception " << 1e3 * m.mean_times.perception
                         << ", estimate " << 1e3 * m.mean_times.estimate << ", control " << 1e3 * m.mean_times.control
                         << ")\n  wrote " << (dir / "trajectory.csv").string() << ", metrics.json"
-                        << (plotted ? ", visibility.png" : "");
+                        << (plotted ? ", visibility.png" : "") << (opt->video ? ", episode.avi" : "");
               if (!pictures.empty()) std::cout << " and " << pictures.size() << " scene/camera pictures (" << pictures.front() << " ...)";
               std::cout << '\n';
               return kOk;
