@@ -22,6 +22,9 @@ namespace ofv {
 
 namespace {
 
+constexpr double kDamping = 0.02;       // damped least squares (units of the Jacobian)
+constexpr double kMaxJointSpeed = 2.5;  // [rad/s or m/s] per joint
+
 bool usable(const vpColVector& v, double dt) {
   if (v.size() != 6 || !std::isfinite(dt) || dt < 0.0) return false;
   for (unsigned i = 0; i < 6; ++i) {
@@ -113,13 +116,27 @@ void KinematicArm::set_joints(const vpColVector& q) {
 RobotStep KinematicArm::step(const vpColVector& v, double dt) {
   RobotStep r;
   if (usable(v, dt)) {
-    const vpColVector qdot = impl_->cJ(q_).pseudoInverse() * v;
+    // Damped least squares: near a singularity the pseudo-inverse would ask
+    // for unbounded joint speeds.
+    const vpMatrix J = impl_->cJ(q_);
+    vpMatrix JJt = J * J.t();
+    for (unsigned i = 0; i < 6; ++i) JJt[i][i] += kDamping * kDamping;
+    const vpColVector qdot = J.t() * (JJt.inverseByLU() * v);
     const vpColVector lo = joint_min(), hi = joint_max();
+    // The whole step shortened so that no joint exceeds its speed or passes
+    // its limit: the camera keeps the commanded direction (clamping joints one
+    // by one would turn it) and slows down or stops.
+    double scale = 1.0;
     for (unsigned i = 0; i < 6; ++i) {
-      const double q = q_[i] + qdot[i] * dt;
-      if (q < lo[i] || q > hi[i]) r.limited = true;
-      q_[i] = std::min(std::max(q, lo[i]), hi[i]);
+      if (std::abs(qdot[i]) > kMaxJointSpeed) scale = std::min(scale, kMaxJointSpeed / std::abs(qdot[i]));
     }
+    for (unsigned i = 0; i < 6; ++i) {
+      const double dq = qdot[i] * dt;
+      const double room = dq > 0.0 ? hi[i] - q_[i] : lo[i] - q_[i];
+      if (dq != 0.0 && std::abs(dq) > std::abs(room)) scale = std::min(scale, std::max(0.0, room / dq));
+    }
+    r.limited = scale < 1.0;
+    for (unsigned i = 0; i < 6; ++i) q_[i] = std::min(std::max(q_[i] + scale * qdot[i] * dt, lo[i]), hi[i]);
   }
   r.wMc = wMc();
   return r;

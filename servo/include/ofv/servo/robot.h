@@ -6,8 +6,9 @@
  * - FreeFlyingCamera: ViSP's vpSimulatorCamera (the twist integrated
  *   exactly over dt), deterministic.
  * - KinematicArm on ViSP's kinematic models of the Viper850 (6-axis arm) and
- *   the Afma6 (gantry): q̇ = (cVe eJe)^+ v, integrated over dt, clamped to the
- *   joint limits; faster than real time and deterministic.
+ *   the Afma6 (gantry): q̇ from v by damped least squares on cVe eJe,
+ *   integrated over dt, the step shortened so that no joint exceeds 2.5 rad/s
+ *   (m/s) or passes its limit; faster than real time and deterministic.
  * - ThreadedArm: ViSP's threaded vpSimulatorViper850/Afma6, in wall-clock
  *   time (real-time demos).
  * - VispRobot: any ViSP vpRobot driver (real or threaded simulator) through
