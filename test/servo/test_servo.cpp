@@ -184,6 +184,25 @@ TEST(Robots, JointLimitsClamp) {
   }
 }
 
+// At the wrist singularity of the Viper850 (q5 = 0) the pseudo-inverse asks
+// for unbounded joint speeds; the arm must neither jump nor exceed the
+// commanded camera speed.
+TEST(Robots, ArmsStayBoundedAtASingularity) {
+  KinematicArm arm(KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
+  vpColVector q = KinematicArm::start_joints(KinematicArm::Model::Viper850);
+  q[4] = 1e-4;
+  arm.set_joints(q);
+  const vpColVector v{0.3, 0.2, 0.0, 0.5, 0.4, 0.0};
+  const double dt = 1.0 / 30.0;
+  for (int k = 0; k < 30; ++k) {
+    const vpColVector before = arm.joints();
+    const Eigen::Vector3d p0 = to_eigen(arm.wMc()).translation();
+    (void)arm.step(v, dt);
+    EXPECT_LE((to_eigen(arm.wMc()).translation() - p0).norm(), 1.05 * std::hypot(0.3, 0.2) * dt + 1e-3) << "step " << k;
+    for (unsigned i = 0; i < 6; ++i) EXPECT_LE(std::abs(arm.joints()[i] - before[i]), 2.5 * dt + 1e-12) << "joint " << i;
+  }
+}
+
 TEST(Safety, EachRule) {
   SafetySettings s;
   s.workspace = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 0.05));
