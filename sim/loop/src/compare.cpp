@@ -525,7 +525,11 @@ std::vector<std::string> write_reports(const std::vector<EpisodeRow>& rows,
   const fs::path plot_dir = out / "plots";
   fs::create_directories(plot_dir);
   std::ostringstream script;
+  // gnuplot's default colours repeat after 8: give variants 9-16 their own.
   script << "set terminal pngcairo size 1000,560 font 'Sans,10'\nset datafile separator ','\n"
+            "set linetype 9 lc rgb '#8c564b'\nset linetype 10 lc rgb '#17becf'\nset linetype 11 lc rgb '#bcbd22'\n"
+            "set linetype 12 lc rgb '#7f7f7f'\nset linetype 13 lc rgb '#ff7f0e'\nset linetype 14 lc rgb '#2ca02c'\n"
+            "set linetype 15 lc rgb '#d62728'\nset linetype 16 lc rgb '#9467bd'\nset linetype cycle 16\n"
             "set key outside right\nset grid\n";
   std::vector<std::string> pngs;
   for (std::size_t si = 0; si < scenarios.size(); ++si) {
