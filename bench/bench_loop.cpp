@@ -39,7 +39,8 @@ void BM_CompareThroughput(benchmark::State& state) {
   const int jobs = static_cast<int>(state.range(0));
   std::vector<std::pair<std::string, std::string>> scenarios;
   for (const char* name : {"dvd-one-hand", "dvd-two-hands", "cloth-occluder", "sweep"}) {
-    scenarios.emplace_back(name, ofv::sim::builtin_scenario_dir() + "/" + name + ".yaml");
+    const ofv::sim::Scenario s = ofv::sim::load_scenario(name);  // resolves built-in names to their file
+    scenarios.emplace_back(s.name, s.path);
   }
   ofv::Grid grid;
   grid.seeds = 2;

@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
     // 2. The scenarios: built-in ones by name, or your own YAML files.
     std::vector<std::pair<std::string, std::string>> scenarios;
     for (const char* name : {"dvd-one-hand", "sweep"}) {
-      scenarios.emplace_back(name, ofv::sim::builtin_scenario_dir() + "/" + name + ".yaml");
+      const ofv::sim::Scenario s = ofv::sim::load_scenario(name);  // resolves built-in names to their file
+      scenarios.emplace_back(s.name, s.path);
     }
 
     // 3. Run every scenario x variant x seed in parallel. Each finished
