@@ -32,8 +32,8 @@ BENCHMARK(BM_ControllerUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 // Arg: 0 camera, 1 viper850, 2 afma6.
 void BM_RobotStep(benchmark::State& state) {
-  static const std::array<const char*, 3> names{"camera", "viper850", "afma6"};
-  const auto robot = ofv::make_robot(names[static_cast<std::size_t>(state.range(0))], start_pose());
+  static const std::array<ofv::RobotKind, 3> kinds{ofv::RobotKind::Camera, ofv::RobotKind::Viper850, ofv::RobotKind::Afma6};
+  const auto robot = ofv::make_robot(kinds[static_cast<std::size_t>(state.range(0))], start_pose());
   state.SetLabel(robot->name());
   vpColVector v(6, 0.0);
   v[0] = 0.01;

@@ -1,15 +1,21 @@
 //! \example tutorial-real-robot.cpp
 //! Tutorial 4: attach a real robot. Any ViSP vpRobot driver carries the camera;
-//! ofv::VispRobot commands it in the camera frame and ofv::SafetyFilter stands
-//! between the controller and the hardware (speed, acceleration, workspace,
-//! zero velocity when the object is lost or the frame is stale). This program
-//! is compiled everywhere; the driver part only where ViSP has the driver
-//! (Debian's libvisp-dev has none: it then says so and exits).
+//! ofv::VispRobot commands it in the camera frame. ofv::ViewLoop is the
+//! per-frame policy that `ofv simulate` and `ofv run` use: from the frame's
+//! problem (object supervoxels and occluders, from ofv::Perception on your
+//! sensor's frames) and the camera pose to a safe camera twist — view
+//! selection, target continuity, the controller and the safety filter
+//! (speed, acceleration, workspace, zero velocity when the object is lost or
+//! the frame is stale). This program is compiled everywhere; the driver part
+//! only where ViSP has the driver (Debian's libvisp-dev has none: it then says
+//! so and exits, or with --dry-run prints the commands on a simulated camera).
 //!
 //!   tutorial-real-robot [--dry-run]
-#include <ofv/servo/controller.h>
+//!
+//! With a sensor, `ofv::run_on_robot(source, robot, settings, options)` runs
+//! this same loop (perception included) until Ctrl-C; `ofv run` is that call.
 #include <ofv/servo/robot.h>
-#include <ofv/servo/safety.h>
+#include <ofv/servo/view_loop.h>
 
 #include <visp3/core/vpConfig.h>
 #if defined(VISP_HAVE_VIPER850)
@@ -23,17 +29,34 @@
 namespace {
 volatile std::sig_atomic_t stop_requested = 0;
 void on_sigint(int) { stop_requested = 1; }
+
+// Stand-in for ofv::Perception's output: a 10 x 10 cm patch 0.8 m ahead
+// facing the camera, and a hand-sized occluder that crosses its line of sight.
+ofv::ViewProblem frame_problem(double t) {
+  ofv::ViewProblem p;
+  p.positions.resize(3, 25);
+  p.normals.resize(3, 25);
+  for (int k = 0; k < 25; ++k) {
+    p.positions.col(k) << (k % 5 - 2) * 0.025, (k / 5 - 2) * 0.025, 0.8;
+    p.normals.col(k) << 0, 0, -1;
+  }
+  p.occluders.resize(3, 9);
+  for (int k = 0; k < 9; ++k) p.occluders.col(k) << -0.3 + 0.3 * t + (k % 3) * 0.02, (k / 3 - 1) * 0.02, 0.5;
+  return p;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   const bool dry_run = argc > 1 && std::strcmp(argv[1], "--dry-run") == 0;
   std::signal(SIGINT, on_sigint);  // Ctrl-C: zero velocity, then exit
 
-  ofv::SafetySettings safety;
-  safety.workspace = Eigen::AlignedBox3d(Eigen::Vector3d(-0.4, -0.4, 0.2), Eigen::Vector3d(0.4, 0.4, 0.9));
-  ofv::SafetyFilter filter(safety);
-  ofv::ViewController controller;
+  // 1. Settings by name, as `ofv run --set` takes them; here a workspace box for the camera.
+  ofv::LoopSettings settings;
+  ofv::loop_settings_table().set(settings, "workspace", "-0.4,-0.4,0.1,0.4,0.4,0.9");
+  ofv::loop_settings_table().set(settings, "max_linear_speed", "0.25");
+  ofv::ViewLoop loop(settings);
 
+  // 2. The robot.
 #if defined(VISP_HAVE_VIPER850)
   vpRobotViper850 driver;
   ofv::VispRobot robot(driver, vpHomogeneousMatrix(), "viper850");
@@ -46,19 +69,19 @@ int main(int argc, char** argv) {
   ofv::FreeFlyingCamera robot(vpHomogeneousMatrix(0.0, 0.0, 0.3, 0.0, 0.0, 0.0));
 #endif
 
-  // In a real application, C and t_f come from `ofv perceive`'s pipeline every
-  // frame; here they are fixed: hold a view 20 degrees to the side.
-  const Eigen::Vector3d centroid(0.0, 0.0, 0.8), tf(0.17, 0.0, 0.33);
+  // 3. The loop: one frame period at a time.
+  const double dt = 1.0 / 30.0;
+  int clear = 0;
   for (int k = 0; k < 60 && !stop_requested; ++k) {
-    const double dt = 1.0 / 30.0;
-    const vpColVector v = controller.update(tf, centroid, 0.5, robot.wMc(), dt);
-    const vpColVector safe = filter.filter(v, robot.wMc(), dt, /*object_tracked=*/true, /*frame_age=*/0.0);
+    const ofv::LoopStep s = loop.step(frame_problem(k * dt), robot.wMc(), dt, /*frame_age=*/0.0);
     if (dry_run) {
-      std::cout << "step " << k << ": v = " << safe.t() << (*filter.last_reason() ? "  (" : "")
-                << filter.last_reason() << (*filter.last_reason() ? ")" : "") << '\n';
+      std::cout << "step " << k << ": " << ofv::to_string(s.status) << ", v = " << s.velocity.t();
+      if (s.safety != ofv::SafetyAction::None) std::cout << "  (" << ofv::to_string(s.safety) << ')';
+      std::cout << '\n';
     }
-    robot.step(safe, dt);
+    clear += s.status == ofv::StepStatus::Converged || s.status == ofv::StepStatus::NoOccluders ? 1 : 0;
+    robot.step(s.velocity, dt);
   }
   robot.step(vpColVector(6, 0.0), 0.0);  // leave the robot at rest
-  return 0;
+  return clear > 0 ? 0 : 1;
 }

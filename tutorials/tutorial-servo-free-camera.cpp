@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
         ofv::run_episode(setup, [&](const ofv::StepRecord& step, const ofv::StepDetail&) {
           if (std::fmod(step.time + 1e-9, 0.5) < 1.0 / scenario.rate) {
             std::cout << "t=" << step.time << " s  visible " << step.visible_fraction << "  camera "
-                      << step.wMc.translation().transpose() << "  " << step.status << '\n';
+                      << step.wMc.translation().transpose() << "  " << ofv::to_string(step.status) << '\n';
           }
         });
 

@@ -1,12 +1,9 @@
-// `ofv run --robot NAME --source SOURCE [--dry-run]`: the closed loop on a
-// robot and a sensor: frames → perception → estimator → controller → safety
-// filter → robot.
+// `ofv run --robot NAME --source SOURCE [--set name=value ...] [--dry-run]`:
+// the closed loop on a robot and a sensor, a recording, or a live simulation.
 #include "commands.h"
 
-#include "ofv/perception/perception.h"
-#include "ofv/servo/controller.h"
-#include "ofv/servo/robot.h"
-#include "ofv/servo/safety.h"
+#include "ofv/loop/episode.h"
+#include "ofv/servo/robot_loop.h"
 #include "ofv/servo/target_pose.h"
 
 #include <visp3/core/vpConfig.h>
@@ -18,18 +15,18 @@
 #include <visp3/robot/vpRobotAfma6.h>
 #endif
 
-#include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
-#include <iomanip>
 #include <iostream>
+#include <limits>
 
 namespace ofv::cli {
 
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-void on_sigint(int) { g_stop = 1; }
+void on_signal(int) { g_stop = 1; }
 
 // The camera-to-end-effector transform from a file of six numbers:
 // tx ty tz [m] thetaux thetauy thetauz [rad] (ViSP's vpPoseVector of eMc).
@@ -57,6 +54,34 @@ std::string real_drivers() {
   return list.empty() ? "none in this ViSP build" : list;
 }
 
+// A real driver by name, or nullptr for the simulated robots.
+std::unique_ptr<CameraRobot> real_robot(const std::string& name, const vpHomogeneousMatrix& eMc) {
+  (void)eMc;
+#if defined(VISP_HAVE_VIPER850)
+  if (name == "viper850-real") {
+    static vpRobotViper850 driver;
+    driver.init(vpViper850::TOOL_CUSTOM, eMc);
+    return std::make_unique<VispRobot>(driver, vpHomogeneousMatrix(), name);
+  }
+#endif
+#if defined(VISP_HAVE_AFMA6)
+  if (name == "afma6-real") {
+    static vpRobotAfma6 driver;
+    driver.init(vpAfma6::TOOL_CUSTOM, eMc);
+    return std::make_unique<VispRobot>(driver, vpHomogeneousMatrix(), name);
+  }
+#endif
+  (void)name;
+  return nullptr;
+}
+
+// One JSON line per command (dry run): frame, time, status, twist (17 digits), safety action.
+void print_command(long frame, double t, const char* status, const vpColVector& v, const char* safety) {
+  std::printf("{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
+  for (unsigned i = 0; i < 6; ++i) std::printf("%s%.17g", i ? ", " : "", v[i]);
+  std::printf("], \"safety\": \"%s\"}\n", safety);
+}
+
 }  // namespace
 
 Command add_run_command(CLI::App& app) {
@@ -66,108 +91,85 @@ Command add_run_command(CLI::App& app) {
     std::string emc;
     std::vector<std::string> sets;
     bool dry_run = false;
-    double max_speed = 0.25;
-    double stale = 0.2;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* sub = app.add_subcommand("run", "Run the closed loop on a robot and a sensor (or a recording, dry run)");
+  CLI::App* sub = app.add_subcommand("run", "Run the closed loop on a robot and a sensor, a recording, or a live simulation");
   sub->add_option("--robot", opt->robot,
-                   "camera, viper850, afma6 (ViSP kinematic models, no hardware), or a real driver: " + real_drivers())
+                  "camera, viper850, afma6 (ViSP's kinematic models; with a sim: source, ViSP's threaded simulators), "
+                  "or a real driver: " + real_drivers())
       ->capture_default_str();
-  sub->add_option("--source", opt->source, "Frames: TUM folder, PCD sequence, FILE.oni or openni2://URI")->required();
+  sub->add_option("--source", opt->source,
+                  "Frames: TUM folder, PCD sequence, FILE.oni, openni2://URI, or sim:SCENARIO (the scenario rendered "
+                  "live from the simulated arm's camera: a rehearsal without hardware)")
+      ->required();
   sub->add_option("--emc", opt->emc, "File with the camera-end-effector transform eMc: tx ty tz tux tuy tuz");
-  sub->add_option("--set", opt->sets, "Estimator setting name=value (repeatable)")->type_name("NAME=VALUE");
-  sub->add_flag("--dry-run", opt->dry_run, "Print every command (JSON lines) instead of sending it to hardware");
-  sub->add_option("--max-speed", opt->max_speed, "Safety: linear speed limit [m/s]")->capture_default_str();
-  sub->add_option("--stale", opt->stale, "Safety: frames older than this stop the robot [s]")->capture_default_str();
-  sub->footer("Ctrl-C stops the robot (zero velocity) and exits. The object is picked in the first frame "
-              "(the cluster nearest the image centre); when it is lost the robot stops.");
+  sub->add_option("--set", opt->sets, "Any setting of 'ofv simulate' as name=value (repeatable), same defaults")
+      ->type_name("NAME=VALUE");
+  sub->add_flag("--dry-run", opt->dry_run,
+                "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
+  sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits. The object is picked in the first frame "
+              "(the cluster nearest the image centre); when it is lost, or a frame is stale, the robot stops.\n"
+              "Settings are those of 'ofv simulate --help'.");
 
   return {sub, [opt]() -> int {
+            const bool simulated = opt->source.rfind("sim:", 0) == 0;
+            const bool real = opt->robot.size() > 5 && opt->robot.compare(opt->robot.size() - 5, 5, "-real") == 0;
+            EpisodeSetup setup;
             std::unique_ptr<FrameSource> source;
             std::unique_ptr<CameraRobot> robot;
-            EstimatorSettings settings;
-            SafetySettings safety;
             try {
-              EstimatorParams params;
-              apply_sets(params, opt->sets);
-              settings = params.resolve();
-              if (!(opt->max_speed > 0.0) || !(opt->stale > 0.0)) throw std::invalid_argument("--max-speed and --stale must be positive");
-              safety.max_linear_speed = opt->max_speed;
-              safety.stale_timeout = opt->stale;
-              vpHomogeneousMatrix eMc;
-              if (!opt->emc.empty()) eMc = read_eMc(opt->emc);
-              if (opt->robot == "camera" || opt->robot == "viper850" || opt->robot == "afma6") {
-                robot = make_robot(opt->robot, vpHomogeneousMatrix());
-#if defined(VISP_HAVE_VIPER850)
-              } else if (opt->robot == "viper850-real") {
-                static vpRobotViper850 driver;
-                driver.init(vpViper850::TOOL_CUSTOM, eMc);
-                robot = std::make_unique<VispRobot>(driver, vpHomogeneousMatrix(), "viper850-real");
-#endif
-#if defined(VISP_HAVE_AFMA6)
-              } else if (opt->robot == "afma6-real") {
-                static vpRobotAfma6 driver;
-                driver.init(vpAfma6::TOOL_CUSTOM, eMc);
-                robot = std::make_unique<VispRobot>(driver, vpHomogeneousMatrix(), "afma6-real");
-#endif
+              std::vector<std::pair<std::string, std::string>> settings;
+              for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
+              if (!real) settings.insert(settings.begin(), {"robot", opt->robot});
+              if (simulated) {
+                setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
+                setup.real_time = true;
               } else {
-                throw std::invalid_argument("--robot " + opt->robot + ": unknown (simulated: camera, viper850, afma6; real drivers: " + real_drivers() + ")");
+                setup.duration = std::numeric_limits<double>::infinity();
+                episode_settings_table().apply(setup, settings);
+                (void)ViewLoop(setup.loop);  // validates
+                if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time) {
+                  throw std::invalid_argument("settings perception, seed and real_time need --source sim:SCENARIO");
+                }
+                const vpHomogeneousMatrix eMc = opt->emc.empty() ? vpHomogeneousMatrix() : read_eMc(opt->emc);
+                robot = real ? real_robot(opt->robot, eMc) : make_robot(setup.robot, vpHomogeneousMatrix());
+                if (!robot) {
+                  throw std::invalid_argument("--robot " + opt->robot + ": unknown (simulated: camera, viper850, afma6; real drivers: " +
+                                              real_drivers() + ")");
+                }
+                source = open_source(opt->source, 1.0f);
               }
-              source = open_source(opt->source, 1.0f);
-            } catch (const std::invalid_argument& e) {
+            } catch (const std::exception& e) {  // sources report unreadable paths as runtime errors: here they are bad input
               std::cerr << "ofv run: " << e.what() << '\n';
               return kUsage;
             }
-            std::signal(SIGINT, on_sigint);
-            try {
-              PerceptionSettings ps;
-              ps.r_sphere = settings.r_sphere;
-              ps.supervoxels.seed_resolution = settings.r_seed;
-              Perception perception(ps);
-              ViewController controller;
-              SafetyFilter filter(safety);
-              const bool live = opt->source.rfind("openni2://", 0) == 0;
-              std::optional<double> last_stamp;
-              long frames = 0, lost = 0;
-              while (!g_stop) {
-                const auto read_at = std::chrono::steady_clock::now();
-                std::optional<RgbdFrame> frame = source->next();
-                if (!frame) break;
-                // Eye-in-hand: a live sensor's pose is the robot's camera pose.
-                if (live) frame->wMc = to_eigen(robot->wMc());
-                const double dt = last_stamp ? std::max(1e-3, frame->timestamp - *last_stamp) : 1.0 / 30.0;
-                last_stamp = frame->timestamp;
-                const PerceptionResult r = perception.process(*frame);
-                vpColVector v(6, 0.0);
-                std::optional<ViewEstimate> e;
-                if (r.status != TrackingStatus::Lost) {
-                  try {
-                    e = estimate_view(r.problem, settings);
-                    v = controller.update(e->tf, e->centroid, settings.r_sphere, to_visp(frame->wMc), dt);
-                  } catch (const std::invalid_argument&) {
-                    e.reset();
-                  }
-                }
-                lost += e ? 0 : 1;
-                const double age = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_at).count();
-                const vpColVector safe = filter.filter(v, to_visp(frame->wMc), dt, e.has_value(), age);
-                if (opt->dry_run) {
-                  std::cout << std::setprecision(6) << "{\"frame\": " << frames << ", \"t\": " << frame->timestamp
-                            << ", \"status\": \"" << (e ? to_string(e->status) : "object_lost") << "\", \"v\": [";
-                  for (unsigned i = 0; i < 6; ++i) std::cout << (i ? ", " : "") << safe[i];
-                  std::cout << "], \"safety\": \"" << filter.last_reason() << "\"}\n";
-                }
-                if (!opt->dry_run || opt->robot == "camera" || opt->robot == "viper850" || opt->robot == "afma6") {
-                  (void)robot->step(safe, opt->dry_run ? dt : 0.0);
-                }
-                ++frames;
+            std::signal(SIGINT, on_signal);
+            std::signal(SIGTERM, on_signal);
+            const auto print = [&](const RobotLoopFrame& f) {
+              if (opt->dry_run) {
+                print_command(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity, to_string(f.step->safety));
               }
-              (void)robot->step(vpColVector(6, 0.0), 0.0);  // leave the robot at rest
-              std::cerr << "ofv run: " << frames << " frames, object lost in " << lost << (g_stop ? ", stopped by Ctrl-C" : "") << '\n';
+            };
+            try {
+              if (simulated) {
+                const EpisodeOutcome outcome = rehearse(setup, &g_stop, print);
+                if (opt->dry_run) print_command(outcome.metrics.steps, outcome.metrics.duration, "stop", vpColVector(6, 0.0), "");
+                std::cout << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
+                          << (g_stop ? ", stopped" : "") << '\n'
+                          << episode_summary(outcome.metrics);
+                return kOk;
+              }
+              RobotLoopOptions options;
+              options.pose_from_robot = options.wall_clock_age = opt->source.rfind("openni2://", 0) == 0;
+              options.move_robot = !opt->dry_run || !real;  // simulated robots follow a dry run
+              options.max_duration = setup.duration;
+              options.stop = &g_stop;
+              const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
+              if (opt->dry_run) print_command(summary.frames, 0.0, "stop", vpColVector(6, 0.0), "");
+              std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
+                        << (summary.stopped ? ", stopped by a signal" : "") << '\n';
               return kOk;
             } catch (const std::exception& e) {
-              (void)robot->step(vpColVector(6, 0.0), 0.0);
               std::cerr << "ofv run: " << e.what() << '\n';
               return kRuntimeFailure;
             }

@@ -49,6 +49,7 @@ enum class ViewStatus {
   Converged,     ///< t_f has no projected occlusion point within `clearance`
   NotConverged,  ///< max_iterations reached; t_f is the best visited iterate
   NoOccluders,   ///< no valid occluder: t_f = t0
+  NoSupervoxels,  ///< no usable supervoxel and no given centroid: no view (t0 = tf = camera)
 };
 
 /// \brief Which rule produced t0 after the spec's fallbacks (spec §2).

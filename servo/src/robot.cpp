@@ -1,6 +1,8 @@
 // Robots: free-flying camera, kinematic Viper850/Afma6, any vpRobot.
 #include "ofv/servo/robot.h"
 
+#include "ofv/settings_table.h"
+
 #include <visp3/core/vpPoseVector.h>
 #include <visp3/core/vpTime.h>
 #include <visp3/core/vpVelocityTwistMatrix.h>
@@ -220,18 +222,28 @@ RobotStep ThreadedArm::step(const vpColVector&, double) { return {}; }
 std::string ThreadedArm::name() const { return {}; }
 #endif
 
-std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start,
-                                        bool real_time) {
-  if (name == "camera") {
+const char* to_string(RobotKind kind) {
+  switch (kind) {
+    case RobotKind::Camera: return "camera";
+    case RobotKind::Viper850: return "viper850";
+    case RobotKind::Afma6: return "afma6";
+  }
+  return "?";
+}
+
+RobotKind parse_robot_kind(const std::string& word) {
+  return parse_word<RobotKind>("robot", word,
+                               {{"camera", RobotKind::Camera}, {"viper850", RobotKind::Viper850}, {"afma6", RobotKind::Afma6}});
+}
+
+std::unique_ptr<CameraRobot> make_robot(RobotKind kind, const vpHomogeneousMatrix& wMc_start, bool real_time) {
+  if (kind == RobotKind::Camera) {
     if (real_time) throw std::invalid_argument("robot 'camera' has no real-time simulator (use viper850 or afma6)");
     return std::make_unique<FreeFlyingCamera>(wMc_start);
   }
-  if (name == "viper850" || name == "afma6") {
-    const auto model = name == "viper850" ? KinematicArm::Model::Viper850 : KinematicArm::Model::Afma6;
-    if (real_time) return std::make_unique<ThreadedArm>(model, wMc_start);
-    return std::make_unique<KinematicArm>(model, wMc_start);
-  }
-  throw std::invalid_argument("unknown robot '" + name + "' (expected camera, viper850, afma6)");
+  const auto model = kind == RobotKind::Viper850 ? KinematicArm::Model::Viper850 : KinematicArm::Model::Afma6;
+  if (real_time) return std::make_unique<ThreadedArm>(model, wMc_start);
+  return std::make_unique<KinematicArm>(model, wMc_start);
 }
 
 }  // namespace ofv

@@ -1,38 +1,73 @@
 // Safety filter for real robots.
 #include "ofv/servo/safety.h"
 
-#include "ofv/servo/controller.h"
 #include "ofv/servo/target_pose.h"
+#include "ofv/settings_table.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace ofv {
 
-SafetyFilter::SafetyFilter(const SafetySettings& settings) : settings_(settings) {}
+const char* to_string(SafetyAction action) {
+  switch (action) {
+    case SafetyAction::None: return "";
+    case SafetyAction::SpeedLimit: return "speed limit";
+    case SafetyAction::AccelerationLimit: return "acceleration limit";
+    case SafetyAction::WorkspaceBound: return "workspace bound";
+    case SafetyAction::InvalidCommand: return "invalid command";
+    case SafetyAction::ObjectLost: return "object lost";
+    case SafetyAction::StaleFrame: return "stale frame";
+  }
+  return "?";
+}
+
+bool stops(SafetyAction action) {
+  return action == SafetyAction::InvalidCommand || action == SafetyAction::ObjectLost ||
+         action == SafetyAction::StaleFrame;
+}
+
+void validate(const SafetySettings& s) {
+  const std::pair<const char*, double> limits[] = {{"max_linear_speed", s.max_linear_speed},
+                                                   {"max_angular_speed", s.max_angular_speed},
+                                                   {"max_linear_accel", s.max_linear_accel},
+                                                   {"max_angular_accel", s.max_angular_accel},
+                                                   {"stale_timeout", s.stale_timeout}};
+  for (const auto& [name, v] : limits) {
+    if (!std::isfinite(v) || v <= 0.0) {
+      throw std::invalid_argument(std::string("safety setting '") + name + "' must be finite and positive, got " +
+                                  format_number(v));
+    }
+  }
+}
+
+SafetyFilter::SafetyFilter(const SafetySettings& settings) : settings_(settings) { validate(settings_); }
 
 vpColVector SafetyFilter::filter(const vpColVector& v_in, const vpHomogeneousMatrix& wMc, double dt,
                                  bool object_tracked, double frame_age) {
   // Conditions that stop the robot at once (the drive's own deceleration applies).
-  auto stop = [this](const char* why) {
-    reason_ = why;
+  auto stop = [this](SafetyAction why) {
+    action_ = why;
     previous_ = vpColVector(6, 0.0);
     return previous_;
   };
   bool finite = v_in.size() == 6 && std::isfinite(dt) && dt > 0.0;
   for (unsigned i = 0; finite && i < 6; ++i) finite = std::isfinite(v_in[i]);
-  if (!finite) return stop("invalid command");
-  if (!object_tracked) return stop("object lost");
-  if (!(frame_age <= settings_.stale_timeout)) return stop("stale frame");
+  if (!finite) return stop(SafetyAction::InvalidCommand);
+  if (!object_tracked) return stop(SafetyAction::ObjectLost);
+  if (!(frame_age <= settings_.stale_timeout)) return stop(SafetyAction::StaleFrame);
 
-  reason_ = "";
+  action_ = SafetyAction::None;
   vpColVector v = saturate(v_in, settings_.max_linear_speed, settings_.max_angular_speed);
-  if (v != v_in) reason_ = "speed limit";
+  if (v != v_in) action_ = SafetyAction::SpeedLimit;
   // Acceleration: the change from the previous command, per part.
   const vpColVector dv = v - previous_;
   const vpColVector limited = saturate(dv, settings_.max_linear_accel * dt, settings_.max_angular_accel * dt);
   if (limited != dv) {
     v = previous_ + limited;
-    reason_ = "acceleration limit";
+    action_ = SafetyAction::AccelerationLimit;
   }
   // Workspace: drop the world-frame linear components that would leave the box.
   if (!settings_.workspace.isEmpty()) {
@@ -50,7 +85,7 @@ vpColVector SafetyFilter::filter(const vpColVector& v_in, const vpHomogeneousMat
     if (clipped) {
       const Eigen::Vector3d vc = m.linear().transpose() * vw;
       for (unsigned i = 0; i < 3; ++i) v[i] = vc[static_cast<int>(i)];
-      reason_ = "workspace bound";
+      action_ = SafetyAction::WorkspaceBound;
     }
   }
   previous_ = v;

@@ -1,6 +1,8 @@
 // Scene and result JSON (ESTIMATOR-SPEC.md §8).
 #include "ofv/io/scene_json.h"
 
+#include "ofv/estimator_settings.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cerrno>
@@ -86,47 +88,33 @@ int iterations_param(const json& j, const Where& at) {
   fail(at, "a non-negative integer", j);
 }
 
-// One parameter from JSON; shared by the scene's `params` and `--set`.
+// One parameter of a scene's `params`: the JSON type the setting's row
+// asks for, then the estimator's settings table.
 void set_param_json(EstimatorParams& p, const std::string& name, const json& j, const Where& at) {
-  auto word = [&](const char* listed) -> std::string {
-    if (!j.is_string()) {
-      fail(at, std::string("one of ") + listed, j);
-    }
-    return j.get<std::string>();
-  };
-  if (name == "preset") {
-    const auto v = parse_preset(word("paper, authors_code"));
-    if (!v) fail(at, "one of paper, authors_code", j);
-    p.preset = *v;
-  } else if (name == "r_seed") {
-    p.r_seed = number(j, at);  // range checked by EstimatorParams::resolve()
-  } else if (name == "r_sphere") {
-    p.r_sphere = number(j, at);
-  } else if (name == "initial_view") {
-    const auto v = parse_initial_view(word("spherical_mean, vector_mean"));
-    if (!v) fail(at, "one of spherical_mean, vector_mean", j);
-    p.initial_view = *v;
-  } else if (name == "clearance") {
-    p.clearance = number(j, at);
-  } else if (name == "push_radius") {
-    p.push_radius = number(j, at);
-  } else if (name == "push_weighting") {
-    const auto v = parse_push_weighting(word("sum, inverse_distance"));
-    if (!v) fail(at, "one of sum, inverse_distance", j);
-    p.push_weighting = *v;
-  } else if (name == "step") {
-    p.step = number(j, at);
-  } else if (name == "max_iterations") {
-    p.max_iterations = iterations_param(j, at);
-  } else if (name == "warm_start") {
-    if (!j.is_boolean()) fail(at, "true or false", j);
-    p.warm_start = j.get<bool>();
-  } else {
+  const SettingDoc* row = estimator_settings_table().find(name);
+  if (row == nullptr) {
     std::string list;
     for (const auto& known : param_names()) {
       list += list.empty() ? known : ", " + known;
     }
     fail(at, "unknown parameter (expected one of: " + list + ")");
+  }
+  std::string text;
+  if (row->type == "bool") {
+    if (!j.is_boolean()) fail(at, "true or false", j);
+    text = format_bool(j.get<bool>());
+  } else if (row->type.rfind("integer", 0) == 0) {
+    text = std::to_string(iterations_param(j, at));
+  } else if (row->type.rfind("number", 0) == 0) {
+    text = format_number(number(j, at));  // range checked by EstimatorParams::resolve()
+  } else {
+    if (!j.is_string()) fail(at, "one of " + row->type, j);
+    text = j.get<std::string>();
+  }
+  try {
+    estimator_settings_table().set(p, name, text);
+  } catch (const std::invalid_argument& e) {
+    fail(at, e.what());
   }
 }
 
@@ -153,9 +141,11 @@ ordered_json to_json(const std::optional<AngularErrorStats>& e) {
 }  // namespace
 
 const std::vector<std::string>& param_names() {
-  static const std::vector<std::string> names{
-      "preset", "r_seed",         "r_sphere", "initial_view",   "clearance",
-      "push_radius", "push_weighting", "step", "max_iterations", "warm_start"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& doc : estimator_settings_table().docs()) out.push_back(doc.name);
+    return out;
+  }();
   return names;
 }
 
@@ -240,29 +230,11 @@ Scene read_scene(const std::string& path) {
 }
 
 void set_param(EstimatorParams& params, const std::string& name, const std::string& value) {
-  const std::string source = "--set " + name + "=" + value;
-  const Where at{source, name};
-  json j;
-  if (name == "preset" || name == "initial_view" || name == "push_weighting") {
-    j = value;
-  } else if (name == "warm_start") {
-    if (value == "true" || value == "1" || value == "on") {
-      j = true;
-    } else if (value == "false" || value == "0" || value == "off") {
-      j = false;
-    } else {
-      fail(at, "true or false, got \"" + value + "\"");
-    }
-  } else {
-    // Numbers are read with JSON's grammar, so "0.02", "2e-2" and "500" are
-    // accepted and "abc" or "0.02m" are not.
-    try {
-      j = json::parse(value);
-    } catch (const json::exception&) {
-      j = value;  // reported below as a string of the wrong type
-    }
+  try {
+    estimator_settings_table().set(params, name, value);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("--set " + name + "=" + value + ": " + e.what());
   }
-  set_param_json(params, name, j, at);
 }
 
 ordered_json scene_to_json(const Scene& scene) {

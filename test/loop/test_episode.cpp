@@ -74,7 +74,7 @@ TEST(Episode, SettingsAreValidatedByName) {
   }
   // Lengths may refer to the scenario's radii.
   const EpisodeSetup r = resolve_episode(s, {{"push_radius", "r_seed"}});
-  EXPECT_DOUBLE_EQ(r.estimator.push_radius, 0.02);
+  EXPECT_DOUBLE_EQ(r.loop.estimator.resolve().push_radius, 0.02);
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include "ofv/servo/target_pose.h"
 
 #include <gtest/gtest.h>
+
+#include <limits>
 #include <visp3/core/vpExponentialMap.h>
 
 #include <chrono>
@@ -132,8 +134,10 @@ TEST(ViewController, CommandsAreBoundedAndFinite) {
 TEST(Robots, FollowAConstantTwist) {
   const vpHomogeneousMatrix start = looking_at({0, 0, 0}, {0, 0, 0.5});
   const vpColVector v{0.05, -0.02, 0.03, 0.1, -0.05, 0.08};
-  for (const std::string name : {"camera", "viper850", "afma6"}) {
-    auto robot = make_robot(name, start);
+  for (const RobotKind kind : {RobotKind::Camera, RobotKind::Viper850, RobotKind::Afma6}) {
+    const std::string name = to_string(kind);
+    EXPECT_EQ(parse_robot_kind(name), kind);
+    auto robot = make_robot(kind, start);
     EXPECT_TRUE(to_eigen(robot->wMc()).isApprox(to_eigen(start), 1e-9)) << name;
     const double dt = 0.01;
     const RobotStep step = robot->step(v, dt);
@@ -142,7 +146,7 @@ TEST(Robots, FollowAConstantTwist) {
     EXPECT_LT(Eigen::AngleAxisd(to_eigen(step.wMc).linear().transpose() * expected.linear()).angle(), 1e-4) << name;
     EXPECT_FALSE(step.limited) << name;
   }
-  EXPECT_THROW((void)make_robot("puma560", start), std::invalid_argument);
+  EXPECT_THROW((void)parse_robot_kind("puma560"), std::invalid_argument);
 }
 
 // ViSP's threaded simulator, driven in wall-clock time, against its
@@ -169,7 +173,7 @@ TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
     EXPECT_GT(Eigen::AngleAxisd(to_eigen(start).linear().transpose() * b.linear()).angle(), 5.0 * kPi / 180.0)
         << "the twin should have turned";
   }
-  EXPECT_THROW((void)make_robot("camera", start, /*real_time=*/true), std::invalid_argument);
+  EXPECT_THROW((void)make_robot(RobotKind::Camera, start, /*real_time=*/true), std::invalid_argument);
 }
 
 TEST(Robots, JointLimitsClamp) {
@@ -211,9 +215,9 @@ TEST(Safety, EachRule) {
   {
     SafetyFilter f(s);
     EXPECT_EQ(f.filter(fast, wMc, 0.03, false, 0.0).frobeniusNorm(), 0.0);
-    EXPECT_STREQ(f.last_reason(), "object lost");
+    EXPECT_EQ(f.last_action(), SafetyAction::ObjectLost);
     EXPECT_EQ(f.filter(fast, wMc, 0.03, true, 1.0).frobeniusNorm(), 0.0);
-    EXPECT_STREQ(f.last_reason(), "stale frame");
+    EXPECT_EQ(f.last_action(), SafetyAction::StaleFrame);
   }
   {
     SafetyFilter f(s);  // from rest, the acceleration limit binds first
@@ -229,10 +233,15 @@ TEST(Safety, EachRule) {
     vpColVector forward(6, 0.0);
     forward[2] = 0.01;
     EXPECT_EQ(f.filter(forward, at_edge, 0.03, true, 0.0)[2], 0.0);
-    EXPECT_STREQ(f.last_reason(), "workspace bound");
+    EXPECT_EQ(f.last_action(), SafetyAction::WorkspaceBound);
   }
   SafetyFilter f(s);
   EXPECT_EQ(f.filter(vpColVector{std::nan(""), 0, 0, 0, 0, 0}, wMc, 0.03, true, 0.0).frobeniusNorm(), 0.0);
+  EXPECT_EQ(f.last_action(), SafetyAction::InvalidCommand);
+  EXPECT_TRUE(stops(f.last_action()));
+  SafetySettings bad;
+  bad.max_linear_accel = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(SafetyFilter{bad}, std::invalid_argument);
 }
 
 }  // namespace

@@ -1,14 +1,9 @@
-// The closed loop: render → perceive → choose a view → control → move.
+// The closed loop in simulation: render → perceive → ViewLoop → move.
 #include "ofv/loop/episode.h"
 
-#include "ofv/io/scene_json.h"
-#include "ofv/servo/robot.h"
 #include "ofv/servo/target_pose.h"
+#include "ofv/sim/live_source.h"
 #include "ofv/sim/renderer.h"
-
-#ifdef OFV_LOOP_HAVE_PERCEPTION
-#include "ofv/perception/perception.h"
-#endif
 
 #include <chrono>
 #include <cmath>
@@ -25,120 +20,84 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-double positive_number(const std::string& name, const std::string& value) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != value.size() || !std::isfinite(v) || v <= 0.0) {
-    throw std::invalid_argument("setting '" + name + "' must be a positive number, got \"" + value + "\"");
-  }
-  return v;
+SettingsTable<EpisodeSetup> make_table() {
+  using E = EpisodeSetup;
+  const EpisodeSetup d;
+  SettingsTable<E> t;
+  t.include(loop_settings_table(), [](E& e) -> LoopSettings& { return e.loop; });
+  t.add({"robot", "camera | viper850 | afma6", "the scenario's", "",
+         "free-flying camera, or the arm on ViSP's kinematic model (threaded simulator with real_time)"},
+        [](E& e, const std::string& v) { e.robot = parse_robot_kind(v); });
+  t.add({"perception", "full | ground-truth", to_string(d.perception), "",
+         "PCL front end on the frames, or the simulator's ground-truth supervoxels"},
+        [](E& e, const std::string& v) {
+          e.perception = parse_word<PerceptionMode>("perception", v,
+                                                    {{"full", PerceptionMode::Full}, {"ground-truth", PerceptionMode::GroundTruth}});
+        });
+  t.add({"duration", "number", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
+        [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, 86400.0, true); });
+  t.add({"seed", "integer", std::to_string(d.seed), "",
+         "the scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement"},
+        [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); });
+  t.add({"real_time", "bool", format_bool(d.real_time), "",
+         "run the arm on ViSP's threaded simulator in wall-clock time (robot viper850 or afma6)"},
+        [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); });
+  return t;
 }
 
-bool boolean(const std::string& name, const std::string& value) {
-  if (value != "true" && value != "false") {
-    throw std::invalid_argument("setting '" + name + "' must be true or false, got \"" + value + "\"");
+// What the simulator knows of a frame, for the metrics: visibility, distance
+// to the sphere, the angular error of the camera against the ground-truth
+// supervoxels. Returns the ground-truth problem (the input in ground-truth mode).
+ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const EstimatorSettings& estimator) {
+  const double r_sphere = estimator.r_sphere;
+  const sim::ObjectTruth truth = renderer.truth(rec.wMc, r_sphere);
+  ViewProblem gt_problem = renderer.ground_truth_problem(rec.wMc, estimator.r_seed, r_sphere);
+  rec.visible_fraction = truth.visible_fraction;
+  rec.occluders_in_sphere = truth.occluders_in_sphere;
+  rec.sphere_distance_error = (rec.wMc.translation() - truth.centroid).norm() - r_sphere;
+  const Eigen::Vector3d gt_centroid =
+      gt_problem.positions.cols() > 0 ? Eigen::Vector3d(gt_problem.positions.rowwise().mean()) : truth.centroid;
+  rec.angular_error_deg = mean_angular_error_deg(gt_problem, gt_centroid, r_sphere, rec.wMc.translation());
+  rec.true_centroid = truth.centroid;
+  return gt_problem;
+}
+
+// What the loop did.
+void record_step(StepRecord& rec, const LoopStep& step) {
+  rec.times.estimate = step.estimate_s;
+  rec.times.control = step.control_s;
+  rec.status = step.status;
+  rec.safety = step.safety;
+  if (step.estimate) {
+    rec.t0 = step.estimate->t0;
+    rec.tf = step.estimate->tf;
+    rec.iterations = step.estimate->iterations;
   }
-  return value == "true";
+  rec.target = step.target;
+  for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = step.velocity[i];
 }
 
 }  // namespace
 
-const std::vector<std::string>& episode_setting_names() {
-  static const std::vector<std::string> names{
-      "method", "sampling_candidates", "sampling_occluder_radius", "controller", "gain",
-      "max_linear_speed", "max_angular_speed", "target_filter", "target_hysteresis", "robot", "real_time",
-      "perception", "duration", "seed"};
-  return names;
+const char* to_string(PerceptionMode mode) { return mode == PerceptionMode::Full ? "full" : "ground-truth"; }
+
+const SettingsTable<EpisodeSetup>& episode_settings_table() {
+  static const SettingsTable<EpisodeSetup> table = make_table();
+  return table;
 }
 
 EpisodeSetup resolve_episode(const sim::Scenario& scenario,
                              const std::vector<std::pair<std::string, std::string>>& settings) {
   EpisodeSetup s;
-  s.scenario = scenario;
-  s.robot = scenario.robot;
+  s.loop.estimator = scenario.estimator;
+  s.robot = parse_robot_kind(scenario.robot);
   s.duration = scenario.duration;
-  // The scenario's controller section, then the settings.
-  std::vector<std::pair<std::string, std::string>> all;
-  for (const auto& [k, v] : scenario.controller) all.emplace_back(k == "law" ? "controller" : k, v);
-  all.insert(all.end(), settings.begin(), settings.end());
-
-  EstimatorParams params = scenario.estimator;
-  const auto& estimator_names = param_names();
-  for (const auto& [name, value] : all) {
-    if (std::find(estimator_names.begin(), estimator_names.end(), name) != estimator_names.end()) {
-      // Lengths may refer to the scenario's radii (e.g. push_radius=r_seed).
-      std::string v = value;
-      if (v == "r_seed") v = std::to_string(params.r_seed.value_or(0.02));
-      if (v == "r_sphere") v = std::to_string(params.r_sphere.value_or(0.5));
-      set_param(params, name, v);
-    } else if (name == "method") {
-      s.method = parse_view_method(value);
-    } else if (name == "sampling_candidates") {
-      const double n = positive_number(name, value);
-      if (n != std::floor(n) || n > 1e6) throw std::invalid_argument("setting 'sampling_candidates' must be an integer in [1, 1e6], got \"" + value + "\"");
-      s.sampling.candidates = static_cast<int>(n);
-    } else if (name == "sampling_occluder_radius") {
-      s.sampling.occluder_radius = positive_number(name, value);
-    } else if (name == "controller") {
-      if (value == "pbvs") {
-        s.controller.law = ControllerSettings::Law::Pbvs;
-      } else if (value == "sphere") {
-        s.controller.law = ControllerSettings::Law::Sphere;
-      } else {
-        throw std::invalid_argument("setting 'controller' must be pbvs or sphere, got \"" + value + "\"");
-      }
-    } else if (name == "gain") {
-      s.controller.gain = positive_number(name, value);
-    } else if (name == "max_linear_speed") {
-      s.controller.max_linear_speed = positive_number(name, value);
-    } else if (name == "max_angular_speed") {
-      s.controller.max_angular_speed = positive_number(name, value);
-    } else if (name == "target_filter") {
-      s.controller.target_filter = value == "0" ? 0.0 : positive_number(name, value);
-    } else if (name == "target_hysteresis") {
-      s.target_hysteresis = boolean(name, value);
-    } else if (name == "real_time") {
-      s.real_time = boolean(name, value);
-    } else if (name == "robot") {
-      if (value != "camera" && value != "viper850" && value != "afma6") {
-        throw std::invalid_argument("setting 'robot' must be camera, viper850 or afma6, got \"" + value + "\"");
-      }
-      s.robot = value;
-    } else if (name == "perception") {
-      if (value == "full") {
-        s.perception = PerceptionMode::Full;
-      } else if (value == "ground-truth") {
-        s.perception = PerceptionMode::GroundTruth;
-      } else {
-        throw std::invalid_argument("setting 'perception' must be full or ground-truth, got \"" + value + "\"");
-      }
-    } else if (name == "duration") {
-      s.duration = positive_number(name, value);
-    } else if (name == "seed") {
-      std::size_t used = 0;
-      long seed = -1;
-      try {
-        seed = std::stol(value, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != value.size() || seed < 0) throw std::invalid_argument("setting 'seed' must be a non-negative integer, got \"" + value + "\"");
-      s.scenario = sim::with_seed(scenario, static_cast<unsigned>(seed));
-    } else {
-      std::string list;
-      for (const auto& n : estimator_names) list += (list.empty() ? "" : ", ") + n;
-      for (const auto& n : episode_setting_names()) list += ", " + n;
-      throw std::invalid_argument("unknown setting '" + name + "' (expected one of: " + list + ")");
-    }
-  }
-  s.estimator = params.resolve();
-  validate(s.controller);
-  if (s.real_time && s.robot == "camera") {
+  // The scenario's controller section (`law` is the setting `controller`), then the settings.
+  for (const auto& [k, v] : scenario.controller) episode_settings_table().set(s, k == "law" ? "controller" : k, v);
+  episode_settings_table().apply(s, settings);
+  s.scenario = sim::with_seed(scenario, s.seed);
+  (void)ViewLoop(s.loop);  // validates every loop setting
+  if (s.real_time && s.robot == RobotKind::Camera) {
     throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");
   }
   return s;
@@ -148,137 +107,87 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   const sim::Scenario& scenario = setup.scenario;
   const double dt = 1.0 / scenario.rate;
   const auto steps = static_cast<long>(std::floor(setup.duration * scenario.rate + 1e-9)) + 1;
-  const double r_sphere = setup.estimator.r_sphere;
-  const double r_seed = setup.estimator.r_seed;
 
+  ViewLoop loop(setup.loop);
   sim::Renderer renderer(scenario);
   std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
-  ViewController controller(setup.controller);
-#ifdef OFV_LOOP_HAVE_PERCEPTION
-  std::unique_ptr<Perception> perception;
-  if (setup.perception == PerceptionMode::Full) {
-    PerceptionSettings ps;
-    ps.r_sphere = r_sphere;
-    ps.supervoxels.seed_resolution = r_seed;
-    perception = std::make_unique<Perception>(ps);
-  }
-#else
-  if (setup.perception == PerceptionMode::Full) {
-    throw std::runtime_error("full perception needs ofv built with the perception front end (OFV_BUILD_PERCEPTION=ON)");
-  }
-#endif
+  std::optional<Perception> perception;
+  if (setup.perception == PerceptionMode::Full) perception.emplace(perception_settings(loop.estimator()));
 
   EpisodeOutcome outcome;
-  std::optional<Eigen::Vector3d> previous_view, previous_target;
   for (long k = 0; k < steps; ++k) {
     StepRecord rec;
     rec.time = static_cast<double>(k) * dt;
-    const Eigen::Isometry3d wMc = to_eigen(robot->wMc());
+    const vpHomogeneousMatrix wMc_visp = robot->wMc();
+    const Eigen::Isometry3d wMc = to_eigen(wMc_visp);
     rec.wMc = wMc;
 
     auto start = Clock::now();
     renderer.set_time(rec.time);
-    const sim::RenderedFrame rendered = renderer.render(wMc, k);
+    sim::RenderedFrame rendered = renderer.render(wMc, k);
+    rendered.frame.timestamp = rec.time;
     rec.times.render = seconds_since(start);
 
-    // Ground truth, for the metrics (and the input in ground-truth mode).
-    const sim::ObjectTruth truth = renderer.truth(wMc, r_sphere);
-    const ViewProblem gt_problem = renderer.ground_truth_problem(wMc, r_seed, r_sphere);
-    rec.visible_fraction = truth.visible_fraction;
-    rec.occluders_in_sphere = truth.occluders_in_sphere;
-    rec.sphere_distance_error = (wMc.translation() - truth.centroid).norm() - r_sphere;
-    rec.angular_error_deg =
-        score_view(gt_problem, gt_problem.positions.cols() > 0 ? Eigen::Vector3d(gt_problem.positions.rowwise().mean()) : truth.centroid,
-                   r_sphere, wMc.translation(), setup.sampling.occluder_radius)
-            .mean_error_deg;
+    ViewProblem gt_problem = record_truth(rec, renderer, loop.estimator());
 
     start = Clock::now();
     std::optional<ViewProblem> problem;
-    if (setup.perception == PerceptionMode::GroundTruth) {
-      problem = gt_problem;
-    }
-#ifdef OFV_LOOP_HAVE_PERCEPTION
-    else {
+    if (perception) {
       PerceptionResult result = perception->process(rendered.frame);
       if (result.status != TrackingStatus::Lost) problem = std::move(result.problem);
+    } else {
+      problem = std::move(gt_problem);
     }
-#endif
     rec.times.perception = seconds_since(start);
 
-    start = Clock::now();
-    std::optional<ViewEstimate> estimate;
-    std::optional<Eigen::Vector3d> target;
-    if (problem) {
-      problem->camera = wMc.translation();
-      problem->previous_view = previous_view;
-      try {
-        estimate = estimate_view(*problem, setup.estimator);
-      } catch (const std::invalid_argument&) {
-        estimate.reset();  // e.g. no usable supervoxel: treated as a lost object
-      }
-    }
-    if (estimate) {
-      rec.t0 = estimate->t0;
-      rec.tf = estimate->tf;
-      rec.iterations = estimate->iterations;
-      rec.status = to_string(estimate->status);
-      switch (setup.method) {
-        case ViewMethod::Estimator: target = estimate->tf; break;
-        case ViewMethod::InitialView: target = estimate->t0; break;
-        case ViewMethod::Sampling:
-          target = sample_best_view(*problem, estimate->centroid, r_sphere, setup.sampling).view;
-          break;
-        case ViewMethod::Static: break;
-      }
-      previous_view = estimate->tf;
-      if (setup.target_hysteresis && previous_target && target) {
-        if (setup.method == ViewMethod::Estimator && estimate->iterations > 0) {
-          // t0 is occluded: continue from the previous target (the spec's warm
-          // start), which stays where it is while clear and otherwise moves to
-          // the nearest clear view. While t0 is clear, t0 is the target.
-          ViewProblem from_previous = *problem;
-          from_previous.previous_view = *previous_target;
-          EstimatorSettings warm = setup.estimator;
-          warm.warm_start = true;
-          const ViewEstimate kept = estimate_view(from_previous, warm);
-          if (kept.status != ViewStatus::NotConverged) target = kept.tf;
-        } else if (setup.method == ViewMethod::Sampling) {
-          // Keep the previous view while it sees as much as the new best.
-          const Eigen::Vector3d previous = estimate->centroid + r_sphere * (*previous_target - estimate->centroid).normalized();
-          const double r = setup.sampling.occluder_radius;
-          if (score_view(*problem, estimate->centroid, r_sphere, previous, r).visible_fraction >=
-              score_view(*problem, estimate->centroid, r_sphere, *target, r).visible_fraction) {
-            target = previous;
-          }
-        }
-      }
-      previous_target = target;
-      rec.target = target;
-    } else {
-      rec.status = "object_lost";
-    }
-    rec.times.estimate = seconds_since(start);
-
-    start = Clock::now();
-    vpColVector v(6, 0.0);
-    if (target && setup.method != ViewMethod::Static) {
-      v = controller.update(*target, estimate->centroid, r_sphere, robot->wMc(), dt);
-    }
-    rec.times.control = seconds_since(start);
-    for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = v[i];
+    // The frame is as old as one period when its command is replaced.
+    const LoopStep step = loop.step(problem, wMc_visp, dt, dt);
+    record_step(rec, step);
 
     outcome.steps.push_back(rec);
     if (observer) {
       StepDetail detail;
       detail.frame = &rendered.frame;
       detail.problem = problem ? &*problem : nullptr;
-      detail.estimate = estimate ? &*estimate : nullptr;
-      detail.target = target.value_or(wMc.translation());
-      detail.true_centroid = truth.centroid;
+      detail.step = &step;
       observer(rec, detail);
     }
-    if (k + 1 < steps) (void)robot->step(v, dt);
+    if (k + 1 < steps) (void)robot->step(step.velocity, dt);
   }
+  outcome.metrics = summarise(outcome.steps);
+  return outcome;
+}
+
+EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomic_t* stop,
+                        const std::function<void(const RobotLoopFrame&)>& observer) {
+  if (setup.robot == RobotKind::Camera) {
+    throw std::invalid_argument("a rehearsal needs robot viper850 or afma6 (ViSP's threaded simulators), not camera");
+  }
+  const EstimatorSettings estimator = setup.loop.estimator.resolve();
+  sim::Renderer renderer(setup.scenario);
+  std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(setup.scenario.wMc_start), /*real_time=*/true);
+  sim::LiveSource source(renderer, [&robot] { return to_eigen(robot->wMc()); }, setup.duration);
+
+  RobotLoopOptions options;
+  options.wall_clock_age = true;
+  options.first_period = 1.0 / setup.scenario.rate;
+  options.stop = stop;
+  if (setup.perception == PerceptionMode::GroundTruth) {
+    options.problem_source = [&](const RgbdFrame& frame) -> std::optional<ViewProblem> {
+      return renderer.ground_truth_problem(frame.wMc, estimator.r_seed, estimator.r_sphere);
+    };
+  }
+  EpisodeOutcome outcome;
+  (void)run_on_robot(source, *robot, setup.loop, options, [&](const RobotLoopFrame& f) {
+    StepRecord rec;
+    rec.time = f.frame->timestamp;
+    rec.wMc = f.frame->wMc;
+    (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
+    rec.times.perception = f.perception_s;
+    record_step(rec, *f.step);
+    outcome.steps.push_back(rec);
+    if (observer) observer(f);
+  });
   outcome.metrics = summarise(outcome.steps);
   return outcome;
 }

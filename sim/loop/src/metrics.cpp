@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <iomanip>
 #include <sstream>
 
 namespace ofv {
@@ -58,7 +59,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
     m.max_times.estimate = std::max(m.max_times.estimate, s.times.estimate);
     m.max_times.control = std::max(m.max_times.control, s.times.control);
     m.estimator_iterations_max = std::max(m.estimator_iterations_max, s.iterations);
-    ++statuses[s.status];
+    ++statuses[to_string(s.status)];
   }
   m.duration = total;
   // Time-weighted means; a single step (no duration) weighs as one sample.
@@ -116,15 +117,37 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
   return m;
 }
 
+std::string episode_summary(const EpisodeMetrics& m) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(3) << "  " << m.duration << " s, " << m.steps << " steps\n"
+      << "  visible fraction: mean " << m.mean_visible_fraction << ", min " << m.min_visible_fraction << ", below "
+      << m.visibility_threshold << " for " << m.time_below_threshold << " s\n"
+      << "  occlusions (visible < " << m.visibility_threshold << "): " << m.occlusions.size();
+  if (!m.occlusions.empty()) {
+    out << ", worst recovery ";
+    if (m.max_recovery_time) {
+      out << *m.max_recovery_time << " s";
+    } else {
+      out << "never (" << m.unrecovered_occlusions << " still hidden at the end)";
+    }
+  }
+  out << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path " << m.path_length
+      << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
+      << "  compute per step: " << 1e3 * m.mean_times.total() << " ms (render " << 1e3 * m.mean_times.render
+      << ", perception " << 1e3 * m.mean_times.perception << ", estimate " << 1e3 * m.mean_times.estimate
+      << ", control " << 1e3 * m.mean_times.control << ")\n";
+  return out.str();
+}
+
 std::string trajectory_csv_header() {
-  return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,targetx,targety,targetz,status,iterations,"
+  return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,targetx,targety,targetz,status,safety,iterations,"
          "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,"
          "render_s,perception_s,estimate_s,control_s";
 }
 
 std::string trajectory_csv_row(const StepRecord& s) {
   std::ostringstream out;
-  out.precision(9);
+  out.precision(12);  // velocities to 1e-12: `ofv run` replays them (test cli.one-loop)
   const Eigen::Quaterniond q(s.wMc.rotation());
   const Eigen::Vector3d p = s.wMc.translation();
   auto vec = [&](const std::optional<Eigen::Vector3d>& v) {
@@ -140,7 +163,7 @@ std::string trajectory_csv_row(const StepRecord& s) {
   vec(s.t0);
   vec(s.tf);
   vec(s.target);
-  out << s.status << ',' << s.iterations << ',' << s.visible_fraction << ','
+  out << to_string(s.status) << ',' << to_string(s.safety) << ',' << s.iterations << ',' << s.visible_fraction << ','
       << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
       << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
       << s.times.control;

@@ -31,6 +31,18 @@
 
 namespace ofv {
 
+/// \brief The simulated robots ofv can step (real drivers come through VispRobot).
+enum class RobotKind {
+  Camera,    ///< a free-flying camera (vpSimulatorCamera)
+  Viper850,  ///< ViSP's Viper850 6-axis arm
+  Afma6,     ///< ViSP's Afma6 gantry
+};
+
+/// \brief The robot's word in settings and files: camera, viper850, afma6.
+[[nodiscard]] const char* to_string(RobotKind kind);
+/// \brief The kind named `word`. \throws std::invalid_argument naming the setting `robot` and the word.
+[[nodiscard]] RobotKind parse_robot_kind(const std::string& word);
+
 /// \brief Result of one robot step.
 struct RobotStep {
   vpHomogeneousMatrix wMc;  ///< camera pose after the step
@@ -147,11 +159,11 @@ class ThreadedArm : public CameraRobot {
 };
 
 /**
- * \brief `camera` (FreeFlyingCamera), `viper850` or `afma6` (KinematicArm,
- *        or ThreadedArm when `real_time`).
- * \throws std::invalid_argument naming an unknown robot, or `camera` in real time.
+ * \brief A FreeFlyingCamera, or a KinematicArm (ThreadedArm when `real_time`)
+ *        whose camera starts at `wMc_start`.
+ * \throws std::invalid_argument for the camera in real time.
  */
-[[nodiscard]] std::unique_ptr<CameraRobot> make_robot(const std::string& name, const vpHomogeneousMatrix& wMc_start,
+[[nodiscard]] std::unique_ptr<CameraRobot> make_robot(RobotKind kind, const vpHomogeneousMatrix& wMc_start,
                                                       bool real_time = false);
 
 }  // namespace ofv

@@ -4,6 +4,9 @@
  */
 #pragma once
 
+#include "ofv/servo/controller.h"
+#include "ofv/servo/loop_status.h"
+
 #include <Eigen/Geometry>
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
@@ -12,15 +15,23 @@ namespace ofv {
 
 /// \brief Limits of SafetyFilter (camera frame for velocities, world frame for the workspace).
 struct SafetySettings {
-  double max_linear_speed = 0.25;    ///< [m/s]
-  double max_angular_speed = 0.8;    ///< [rad/s]
-  double max_linear_accel = 1.0;     ///< [m/s^2]
-  double max_angular_accel = 3.0;    ///< [rad/s^2]
+  /// [m/s]; by default the controller's limit, which the filter enforces whatever computed the command.
+  double max_linear_speed = ControllerSettings{}.max_linear_speed;
+  double max_angular_speed = ControllerSettings{}.max_angular_speed;  ///< [rad/s], as the controller's
+  /// [m/s^2]: reaching 0.5 m/s from rest takes 0.125 s. The view controller
+  /// asks for up to 12-30 m/s^2 when an occluder appears; arms such as the
+  /// Viper850 reach a few m/s^2 at the tool.
+  double max_linear_accel = 4.0;
+  double max_angular_accel = 12.0;   ///< [rad/s^2]
   /// The camera must stay inside this box (world frame) [m]; motion that
   /// would leave it is removed. Empty box = no bound.
   Eigen::AlignedBox3d workspace;
   double stale_timeout = 0.2;        ///< frames older than this stop the robot [s]
 };
+
+/// \brief Throws std::invalid_argument naming a limit that is not finite and positive.
+void validate(const SafetySettings& settings);
+
 
 /**
  * \brief Speed, acceleration and workspace limits, and zero velocity when
@@ -28,6 +39,7 @@ struct SafetySettings {
  */
 class SafetyFilter {
  public:
+  /// \throws std::invalid_argument naming a limit that is not finite and positive.
   explicit SafetyFilter(const SafetySettings& settings = {});
   /**
    * \param v camera twist asked for (camera frame).
@@ -39,13 +51,16 @@ class SafetyFilter {
    */
   [[nodiscard]] vpColVector filter(const vpColVector& v, const vpHomogeneousMatrix& wMc, double dt,
                                    bool object_tracked, double frame_age);
-  /// \brief Why the last command was changed ("" when it passed untouched).
-  [[nodiscard]] const char* last_reason() const { return reason_; }
+  /// \brief What the filter did to the last command.
+  [[nodiscard]] SafetyAction last_action() const { return action_; }
+  /// \brief Forgets the previous command (the robot is at rest).
+  void reset() { previous_ = vpColVector(6, 0.0); }
+  [[nodiscard]] const SafetySettings& settings() const { return settings_; }
 
  private:
   SafetySettings settings_;
   vpColVector previous_ = vpColVector(6, 0.0);
-  const char* reason_ = "";
+  SafetyAction action_ = SafetyAction::None;
 };
 
 }  // namespace ofv

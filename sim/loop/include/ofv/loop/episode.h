@@ -1,18 +1,20 @@
 /**
  * \file episode.h
  * \brief One closed-loop episode: render the frame at the camera's pose →
- *        perception (full, or ground truth) → view selection (ofv's estimator
- *        or a baseline) → controller → the robot moves one frame period →
+ *        perception (full, or ground truth) → ofv::ViewLoop (view selection,
+ *        controller, safety filter) → the robot moves one frame period →
  *        next frame. Deterministic for a scenario, settings and seed.
  */
 #pragma once
 
 #include "ofv/estimator.h"
-#include "ofv/loop/baselines.h"
 #include "ofv/loop/compare.h"
 #include "ofv/loop/metrics.h"
 #include "ofv/rgbd_frame.h"
-#include "ofv/servo/controller.h"
+#include "ofv/servo/robot.h"
+#include "ofv/servo/robot_loop.h"
+#include "ofv/servo/view_loop.h"
+#include "ofv/settings_table.h"
 #include "ofv/sim/scenario.h"
 
 #include <functional>
@@ -28,47 +30,40 @@ enum class PerceptionMode {
   Full,         ///< PCL front end on the rendered frame (needs ofv built with perception)
   GroundTruth,  ///< the simulator's ground-truth supervoxels and occluders
 };
+/// \brief The mode's word in settings and files: full, ground-truth.
+[[nodiscard]] const char* to_string(PerceptionMode mode);
 
 /**
  * \brief Everything an episode needs, resolved and validated.
  *
- * Built from a scenario and `name=value` settings (as `ofv simulate --set`
- * and the variants of `ofv compare` give them) by resolve_episode().
+ * Built from a scenario and `name=value` settings (as `ofv simulate --set`,
+ * `ofv run --set` and the variants of `ofv compare` give them) by
+ * resolve_episode().
  */
 struct EpisodeSetup {
   sim::Scenario scenario;
-  EstimatorSettings estimator;
-  ViewMethod method = ViewMethod::Estimator;
-  SamplingSettings sampling;
-  ControllerSettings controller;
-  std::string robot = "camera";
-  PerceptionMode perception = PerceptionMode::GroundTruth;
+  LoopSettings loop;  ///< the per-frame policy: estimator, method, controller, safety
+  RobotKind robot = RobotKind::Camera;
+  PerceptionMode perception = PerceptionMode::Full;
   double duration = 0.0;  ///< [s]
-  /// Target continuity. Re-estimating from scratch every frame, a symmetric
-  /// occlusion can make the target flip between two sides of an occluder and
-  /// the camera dither between them. With this on, while t0 is occluded the
-  /// target the camera follows is re-estimated from the previous target (the
-  /// spec's warm start): it stays while clear and otherwise moves to the
-  /// nearest clear view; once t0 is clear again, t0 is the target. The
-  /// sampling planner keeps its previous view while it sees as much as the new
-  /// best. The recorded t0 and tf stay the plain estimator's.
-  bool target_hysteresis = true;
+  unsigned seed = 0;      ///< the scenario's k-th random world (sim::with_seed)
   /// The arms on ViSP's threaded simulators (ThreadedArm), one frame period
   /// of wall-clock time per step: a real-time demo, not exactly repeatable.
   bool real_time = false;
 };
 
-/// \brief Names accepted by resolve_episode() besides the estimator's settings.
-[[nodiscard]] const std::vector<std::string>& episode_setting_names();
+/**
+ * \brief Every setting of an episode by name: the loop's
+ *        (ofv::loop_settings_table()) and robot, perception, duration, seed,
+ *        real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        `controller` sections and grids all read settings through it.
+ */
+[[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();
 
 /**
- * \brief Applies `name=value` settings to a scenario: any estimator setting
- *        (lengths may be `r_seed` or `r_sphere`, meaning the scenario's
- *        value), `method`, `sampling_candidates`, `sampling_occluder_radius`,
- *        `controller` (law), `gain`, `max_linear_speed`, `max_angular_speed`,
- *        `target_filter`, `target_hysteresis` (true/false), `robot`, `real_time`
- *        (true/false), `perception`,
- *        `duration`, `seed` (k: the scenario's k-th random world, see sim::with_seed).
+ * \brief Applies the scenario's own settings (its estimator and controller
+ *        sections, robot, duration), then `name=value` settings in order,
+ *        then validates.
  * \throws std::invalid_argument naming the setting and the value.
  */
 [[nodiscard]] EpisodeSetup resolve_episode(
@@ -78,9 +73,7 @@ struct EpisodeSetup {
 struct StepDetail {
   const RgbdFrame* frame = nullptr;         ///< the rendered frame
   const ViewProblem* problem = nullptr;     ///< the estimator's input (nullptr when lost)
-  const ViewEstimate* estimate = nullptr;   ///< nullptr when there was no estimate
-  Eigen::Vector3d target = Eigen::Vector3d::Zero();  ///< chosen camera position
-  Eigen::Vector3d true_centroid = Eigen::Vector3d::Zero();
+  const LoopStep* step = nullptr;           ///< what the loop did (estimate, target, velocities)
 };
 
 /// \brief Called after every step; may be empty.
@@ -89,6 +82,20 @@ using StepObserver = std::function<void(const StepRecord&, const StepDetail&)>;
 /// \brief Runs one episode.
 /// \throws std::runtime_error when the loop cannot run (e.g. full perception not built).
 [[nodiscard]] EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observer = {});
+
+/**
+ * \brief Rehearses a deployment without hardware: the episode's arm on
+ *        ViSP's threaded simulator (robot viper850 or afma6) in wall-clock
+ *        time, a simulated sensor rendering the scenario live from the arm's
+ *        current camera pose (sim::LiveSource), and the loop of `ofv run`
+ *        (ofv::run_on_robot) with its frame timing, stale frames and stop flag.
+ * \param stop     a signal handler's flag, or nullptr.
+ * \param observer sees every frame (e.g. to print the commands).
+ * \return the episode, summarised from the simulator's ground truth at each frame.
+ * \throws std::invalid_argument when the robot is not an arm.
+ */
+[[nodiscard]] EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomic_t* stop,
+                                      const std::function<void(const RobotLoopFrame&)>& observer = {});
 
 /// \brief The runner `ofv compare` uses: loads the spec's scenario, applies its
 ///        variant and seed, runs the episode.

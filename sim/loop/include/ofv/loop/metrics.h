@@ -8,6 +8,8 @@
  */
 #pragma once
 
+#include "ofv/servo/loop_status.h"
+
 #include <Eigen/Geometry>
 
 #include <iosfwd>
@@ -30,15 +32,17 @@ struct StageTimes {
 struct StepRecord {
   double time = 0.0;                                       ///< simulated time [s]
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();   ///< camera pose at the frame
-  Eigen::Matrix<double, 6, 1> velocity = Eigen::Matrix<double, 6, 1>::Zero();  ///< commanded (v, w), camera frame [m/s, rad/s]
+  Eigen::Matrix<double, 6, 1> velocity = Eigen::Matrix<double, 6, 1>::Zero();  ///< sent to the robot (v, w), camera frame [m/s, rad/s]
   std::optional<Eigen::Vector3d> t0;  ///< estimator's initial view (none when no estimate)
   std::optional<Eigen::Vector3d> tf;  ///< estimator's final view
   std::optional<Eigen::Vector3d> target;  ///< the view the controller drove to (after hysteresis, or a baseline's)
-  std::string status;                 ///< estimator status, or "object_lost", "static" ...
+  StepStatus status = StepStatus::ObjectLost;  ///< what the loop did with the frame
+  SafetyAction safety = SafetyAction::None;    ///< what the safety filter did to the command
   int iterations = 0;                 ///< estimator push steps
   double visible_fraction = 0.0;      ///< true fraction of the object surface seen [0, 1]
-  double angular_error_deg = 0.0;     ///< eq. 9 of the real camera vs the true normals [deg]
+  double angular_error_deg = 0.0;     ///< eq. 9 of the real camera against the ground-truth supervoxels [deg]
   double sphere_distance_error = 0.0; ///< |camera - true centroid| - r_sphere [m]
+  Eigen::Vector3d true_centroid = Eigen::Vector3d::Zero();  ///< the object's surface centroid [m]
   int occluders_in_sphere = 0;        ///< ground truth: occluders inside the sphere
   StageTimes times;                   ///< compute time of this step
 };
@@ -87,6 +91,9 @@ struct EpisodeMetrics {
  */
 [[nodiscard]] EpisodeMetrics summarise(const std::vector<StepRecord>& steps,
                                        double threshold = 0.9, double hold = 0.2);
+
+/// \brief The summary as `ofv simulate` and `ofv run` print it: a few indented lines.
+[[nodiscard]] std::string episode_summary(const EpisodeMetrics& m);
 
 /// \brief Header line of trajectory.csv.
 [[nodiscard]] std::string trajectory_csv_header();

@@ -1,7 +1,10 @@
 /**
- * \file baselines.h
- * \brief What ofv's estimator is compared against in closed loop.
+ * \file view_methods.h
+ * \brief View selection: ofv's estimator and what it is compared against.
  *
+ * The closed loop (ofv::ViewLoop) picks the camera's target view with one of
+ * these methods:
+ * - the occlusion-free view estimator (estimator.h, ESTIMATOR-SPEC);
  * - a static camera (never moves);
  * - the occlusion-blind initial view t0 (the authors' previous method);
  * - a sampling next-best-view planner: candidate views spread evenly on the
@@ -21,7 +24,7 @@
 
 namespace ofv {
 
-/// \brief The view-selection methods of the closed-loop harness.
+/// \brief The view-selection methods of the closed loop.
 enum class ViewMethod {
   Estimator,  ///< ofv's occlusion-free view (t_f)
   Static,     ///< keep the camera where it is
@@ -29,9 +32,8 @@ enum class ViewMethod {
   Sampling,   ///< best of many candidate views on the sphere
 };
 
+/// \brief The method's word in settings and files: estimator, static, initial_view, sampling.
 [[nodiscard]] const char* to_string(ViewMethod m);
-/// \throws std::invalid_argument listing the valid words.
-[[nodiscard]] ViewMethod parse_view_method(const std::string& word);
 
 /// \brief `n` unit directions spread evenly on the sphere (Fibonacci lattice).
 [[nodiscard]] Eigen::Matrix3Xd fibonacci_directions(int n);
@@ -60,6 +62,14 @@ struct ScoredView {
 [[nodiscard]] ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                                     double r_sphere, const Eigen::Vector3d& view,
                                     double occluder_radius);
+
+/**
+ * \brief Mean angular error (eq. 9, spec §6) of a camera position: the angle,
+ *        seen from `centroid`, between the camera and each usable
+ *        supervoxel's normal-to-sphere ray [deg]; 0 without usable supervoxels.
+ */
+[[nodiscard]] double mean_angular_error_deg(const ViewProblem& problem, const Eigen::Vector3d& centroid,
+                                            double r_sphere, const Eigen::Vector3d& view);
 
 /**
  * \brief The sampling next-best-view planner: the candidate with the largest

@@ -1,5 +1,5 @@
-// Baselines of the closed-loop comparison.
-#include "ofv/loop/baselines.h"
+// View selection methods besides the estimator (baselines).
+#include "ofv/view_methods.h"
 
 #include <algorithm>
 #include <cmath>
@@ -89,15 +89,6 @@ const char* to_string(ViewMethod m) {
   return "?";
 }
 
-ViewMethod parse_view_method(const std::string& word) {
-  for (auto m : {ViewMethod::Estimator, ViewMethod::Static, ViewMethod::InitialView,
-                 ViewMethod::Sampling}) {
-    if (word == to_string(m)) return m;
-  }
-  throw std::invalid_argument("unknown view method \"" + word +
-                              "\" (expected one of: estimator, static, initial_view, sampling)");
-}
-
 Eigen::Matrix3Xd fibonacci_directions(int n) {
   if (n < 1) throw std::invalid_argument("candidate count must be >= 1, got " + std::to_string(n));
   Eigen::Matrix3Xd d(3, n);
@@ -115,6 +106,14 @@ ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroi
                       const Eigen::Vector3d& view, double occluder_radius) {
   return score(used_supervoxels(problem, centroid, r_sphere), finite_occluders(problem), centroid,
                view, occluder_radius);
+}
+
+double mean_angular_error_deg(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
+                              const Eigen::Vector3d& view) {
+  const UsedSupervoxels u = used_supervoxels(problem, centroid, r_sphere);
+  double error = 0.0;
+  for (Eigen::Index i = 0; i < u.ray.cols(); ++i) error += angle_between(u.ray.col(i), view - centroid);
+  return u.ray.cols() > 0 ? error / static_cast<double>(u.ray.cols()) * kRadToDeg : 0.0;
 }
 
 ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,

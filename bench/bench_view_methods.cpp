@@ -1,7 +1,7 @@
 // The estimator against the sampling next-best-view planner on the same
 // inputs: time per frame (the benchmark) and the visibility each achieves
 // (counter `visible`: fraction of supervoxels seen past the occluders).
-#include "ofv/loop/baselines.h"
+#include "ofv/view_methods.h"
 #include "scenes.h"
 
 #include <benchmark/benchmark.h>

@@ -1,5 +1,5 @@
-// Baselines: Fibonacci candidates, view scoring and the sampling planner.
-#include "ofv/loop/baselines.h"
+// View methods: Fibonacci candidates, view scoring, the angular error and the sampling planner.
+#include "ofv/view_methods.h"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +21,7 @@ ViewProblem occluded_patch() {
   return p;
 }
 
-TEST(Baselines, FibonacciDirectionsCoverTheSphereEvenly) {
+TEST(ViewMethods, FibonacciDirectionsCoverTheSphereEvenly) {
   const Eigen::Matrix3Xd d = fibonacci_directions(500);
   ASSERT_EQ(d.cols(), 500);
   EXPECT_LT((d.colwise().norm().array() - 1.0).abs().maxCoeff(), 1e-12);
@@ -38,7 +38,7 @@ TEST(Baselines, FibonacciDirectionsCoverTheSphereEvenly) {
   EXPECT_THROW((void)fibonacci_directions(0), std::invalid_argument);
 }
 
-TEST(Baselines, OccluderOnTheInitialRay) {
+TEST(ViewMethods, OccluderOnTheInitialRay) {
   const ViewProblem p = occluded_patch();
   const EstimatorSettings s;
   const ViewEstimate e = estimate_view(p, s);
@@ -58,7 +58,7 @@ TEST(Baselines, OccluderOnTheInitialRay) {
   EXPECT_LT(sampled.mean_error_deg, 45.0);
 }
 
-TEST(Baselines, FacingAwaySupervoxelsAreUnseen) {
+TEST(ViewMethods, FacingAwaySupervoxelsAreUnseen) {
   ViewProblem p = occluded_patch();
   p.occluders.resize(3, 0);
   const Eigen::Vector3d c(0, 0, 0.5);
@@ -66,12 +66,18 @@ TEST(Baselines, FacingAwaySupervoxelsAreUnseen) {
   EXPECT_EQ(score_view(p, c, 0.5, Eigen::Vector3d(0, 0, 1), 0.015).visible_fraction, 0.0);
 }
 
-TEST(Baselines, MethodWords) {
-  for (auto m : {ViewMethod::Estimator, ViewMethod::Static, ViewMethod::InitialView,
-                 ViewMethod::Sampling}) {
-    EXPECT_EQ(parse_view_method(to_string(m)), m);
-  }
-  EXPECT_THROW((void)parse_view_method("nbv"), std::invalid_argument);
+TEST(ViewMethods, AngularErrorIsTheAngleToEachRayFromTheCentroid) {
+  // Two supervoxels at C facing +z and +x: rays along +z and +x. A camera
+  // 30 degrees from +z towards +x is 30 and 60 degrees off them (eq. 9).
+  ViewProblem p;
+  p.positions = Eigen::Matrix3Xd::Zero(3, 2);
+  p.normals.resize(3, 2);
+  p.normals << 0, 1, 0, 0, 1, 0;
+  const double a = 30.0 * 3.14159265358979323846 / 180.0;
+  const Eigen::Vector3d view(0.5 * std::sin(a), 0.0, 0.5 * std::cos(a));
+  EXPECT_NEAR(mean_angular_error_deg(p, Eigen::Vector3d::Zero(), 0.5, view), 45.0, 1e-9);
+  // Supervoxels at or outside the sphere are skipped (spec §1).
+  EXPECT_EQ(mean_angular_error_deg(p, Eigen::Vector3d(1, 0, 0), 0.5, view), 0.0);
 }
 
 }  // namespace

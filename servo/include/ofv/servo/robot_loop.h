@@ -1,0 +1,76 @@
+/**
+ * \file robot_loop.h
+ * \brief The closed loop on a robot: frames from a sensor or a recording →
+ *        perception → ofv::ViewLoop → the robot, until the source ends or a
+ *        stop is requested. `ofv run`, the rehearsal on ViSP's threaded
+ *        simulators and the real-robot tutorial use it.
+ */
+#pragma once
+
+#include "ofv/frame_source.h"
+#include "ofv/perception/perception.h"
+#include "ofv/servo/robot.h"
+#include "ofv/servo/view_loop.h"
+
+#include <csignal>
+#include <functional>
+#include <limits>
+#include <optional>
+
+namespace ofv {
+
+/// \brief Perception settings for a loop: the estimator's r_sphere and seed resolution, the rest default.
+[[nodiscard]] PerceptionSettings perception_settings(const EstimatorSettings& estimator);
+
+/// \brief How run_on_robot() treats its source and robot.
+struct RobotLoopOptions {
+  /// The frame's camera pose is the robot's when the frame arrives (a live
+  /// eye-in-hand sensor); otherwise the frame carries its pose (recordings,
+  /// the simulated sensor).
+  bool pose_from_robot = false;
+  /// A frame's age is the wall-clock time since it arrived (live sources);
+  /// otherwise the gap to the previous frame's timestamp (recordings).
+  bool wall_clock_age = false;
+  /// Step the robot with each command (false: a dry run that only reports them).
+  bool move_robot = true;
+  /// Stop after this much source time [s].
+  double max_duration = std::numeric_limits<double>::infinity();
+  /// Period of the first frame when the source does not say [s].
+  double first_period = 1.0 / 30.0;
+  /// When set, stop as soon as it reads non-zero (a signal handler's flag).
+  const volatile std::sig_atomic_t* stop = nullptr;
+  /// When set, the estimator's input comes from here instead of the
+  /// perception front end (simulated ground truth); std::nullopt = lost.
+  std::function<std::optional<ViewProblem>(const RgbdFrame&)> problem_source;
+};
+
+/// \brief One frame of run_on_robot(), for printing and recording.
+struct RobotLoopFrame {
+  long index = 0;
+  const RgbdFrame* frame = nullptr;
+  const PerceptionResult* perception = nullptr;  ///< nullptr with a problem_source
+  const LoopStep* step = nullptr;
+  double dt = 0.0;         ///< period the command is applied for [s]
+  double frame_age = 0.0;  ///< [s]
+  double perception_s = 0.0;  ///< compute time of perception [s]
+};
+
+/// \brief How a run ended.
+struct RobotLoopSummary {
+  long frames = 0;
+  long lost = 0;         ///< frames without the object
+  bool stopped = false;  ///< ended by the stop flag
+};
+
+/**
+ * \brief Runs the loop until the source ends, `max_duration` passes or the
+ *        stop flag is raised; then, when it moves the robot, sends a zero
+ *        velocity (also when an exception leaves it), so the robot is left at rest.
+ * \throws std::invalid_argument for invalid settings; whatever the source,
+ *         perception or robot throw at run time.
+ */
+RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const LoopSettings& settings,
+                              const RobotLoopOptions& options,
+                              const std::function<void(const RobotLoopFrame&)>& observer = {});
+
+}  // namespace ofv

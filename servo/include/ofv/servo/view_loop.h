@@ -1,0 +1,120 @@
+/**
+ * \file view_loop.h
+ * \brief The per-frame policy of ofv, once for simulation and robots:
+ *        problem + camera pose → view selection (the estimator or a
+ *        baseline) → target continuity → controller → safety filter →
+ *        camera twist and a typed status.
+ *
+ * Every caller uses it: the simulated episode (ofv::run_episode), `ofv run`
+ * on hardware or recordings (ofv::run_on_robot), the tutorials. Perception
+ * (or the simulator's ground truth) comes before it, the robot after it.
+ *
+ * \code
+ * ofv::LoopSettings settings;                      // documented defaults
+ * ofv::loop_settings_table().set(settings, "gain", "6");
+ * ofv::ViewLoop loop(settings);
+ * while (...) {
+ *   std::optional<ofv::ViewProblem> problem = ...;  // nullopt when the object is lost
+ *   const ofv::LoopStep s = loop.step(std::move(problem), robot.wMc(), dt, frame_age);
+ *   robot.step(s.velocity, dt);
+ * }
+ * \endcode
+ */
+#pragma once
+
+#include "ofv/estimator.h"
+#include "ofv/servo/controller.h"
+#include "ofv/servo/loop_status.h"
+#include "ofv/servo/safety.h"
+#include "ofv/settings_table.h"
+#include "ofv/view_methods.h"
+
+#include <Eigen/Core>
+#include <visp3/core/vpColVector.h>
+#include <visp3/core/vpHomogeneousMatrix.h>
+
+#include <optional>
+
+namespace ofv {
+
+/// \brief Every setting of the loop; ofv::loop_settings_table() names them.
+struct LoopSettings {
+  EstimatorParams estimator;                  ///< the spec's settings (preset + explicit values)
+  ViewMethod method = ViewMethod::Estimator;  ///< how the target view is chosen
+  SamplingSettings sampling;                  ///< for ViewMethod::Sampling
+  ControllerSettings controller;
+  /// The last filter before the robot. Its speed limits are set together
+  /// with the controller's by the table's `max_linear_speed` and
+  /// `max_angular_speed`.
+  SafetySettings safety;
+  /// Target continuity. Re-estimating from scratch every frame, a symmetric
+  /// occlusion can make the target flip between two sides of an occluder and
+  /// the camera dither between them. With this on, while t0 is occluded the
+  /// target is re-estimated from the previous target (the spec's warm
+  /// start): it stays while clear and otherwise moves to the nearest clear
+  /// view; once t0 is clear again, t0 is the target. The sampling planner
+  /// keeps its previous view while it sees as much as the new best.
+  bool target_hysteresis = true;
+};
+
+/**
+ * \brief The loop's settings by name: the estimator's (ofv::estimator_settings_table())
+ *        and method, sampling_candidates, sampling_occluder_radius, controller,
+ *        gain, adaptive_gain, max_linear_speed, max_angular_speed, target_filter,
+ *        target_hysteresis, max_linear_accel, max_angular_accel, stale_timeout, workspace.
+ */
+[[nodiscard]] const SettingsTable<LoopSettings>& loop_settings_table();
+
+
+/// \brief The loop's output for one frame. World frame [m]; twists in the camera frame.
+struct LoopStep {
+  StepStatus status = StepStatus::ObjectLost;
+  std::optional<ViewEstimate> estimate;   ///< the estimator's result (none when the object is lost)
+  std::optional<Eigen::Vector3d> target;  ///< the view the controller drives to (none: hold still)
+  vpColVector command = vpColVector(6, 0.0);   ///< the controller's twist [m/s, rad/s]
+  vpColVector velocity = vpColVector(6, 0.0);  ///< after the safety filter: send this to the robot
+  SafetyAction safety = SafetyAction::None;    ///< what the safety filter did
+  double estimate_s = 0.0;  ///< compute time of view selection [s]
+  double control_s = 0.0;   ///< compute time of controller and filter [s]
+};
+
+/**
+ * \brief The per-frame policy. One instance per episode or run: it keeps
+ *        the previous view and target, the controller's filter and the
+ *        safety filter's previous command.
+ */
+class ViewLoop {
+ public:
+  /// \throws std::invalid_argument naming a setting out of range.
+  explicit ViewLoop(const LoopSettings& settings);
+
+  /**
+   * \param problem   the frame's estimator input (world frame), or std::nullopt
+   *                  when perception lost the object. Its camera and
+   *                  previous_view are set by the loop.
+   * \param wMc       camera pose when the frame was taken.
+   * \param dt        period the command will be applied for [s].
+   * \param frame_age how old the frame is when the command is sent [s]
+   *                  (older than the stale timeout: stop).
+   */
+  [[nodiscard]] LoopStep step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
+                              double frame_age);
+
+  /// \brief Forgets the previous view, target and command (a new run).
+  void reset();
+
+  [[nodiscard]] const LoopSettings& settings() const { return settings_; }
+  /// \brief The resolved estimator settings (preset applied).
+  [[nodiscard]] const EstimatorSettings& estimator() const { return estimator_; }
+
+ private:
+  [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate);
+
+  LoopSettings settings_;
+  EstimatorSettings estimator_;
+  ViewController controller_;
+  SafetyFilter safety_;
+  std::optional<Eigen::Vector3d> previous_view_, previous_target_;
+};
+
+}  // namespace ofv

@@ -1,0 +1,73 @@
+// The closed loop on a robot: source → perception → ViewLoop → robot.
+#include "ofv/servo/robot_loop.h"
+
+#include "ofv/servo/target_pose.h"
+
+#include <chrono>
+
+namespace ofv {
+
+PerceptionSettings perception_settings(const EstimatorSettings& estimator) {
+  PerceptionSettings ps;
+  ps.r_sphere = estimator.r_sphere;
+  ps.supervoxels.seed_resolution = estimator.r_seed;
+  return ps;
+}
+
+RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const LoopSettings& settings,
+                              const RobotLoopOptions& options,
+                              const std::function<void(const RobotLoopFrame&)>& observer) {
+  using Clock = std::chrono::steady_clock;
+  ViewLoop loop(settings);
+  std::optional<Perception> perception;
+  if (!options.problem_source) perception.emplace(perception_settings(loop.estimator()));
+  const auto rest = [&] {
+    if (options.move_robot) (void)robot.step(vpColVector(6, 0.0), 0.0);
+  };
+
+  RobotLoopSummary summary;
+  try {
+    std::optional<double> first_stamp, last_stamp;
+    while (options.stop == nullptr || *options.stop == 0) {
+      std::optional<RgbdFrame> frame = source.next();
+      if (!frame) break;
+      const auto arrived = Clock::now();
+      if (!first_stamp) first_stamp = frame->timestamp;
+      if (frame->timestamp - *first_stamp > options.max_duration + 1e-9) break;
+      if (options.pose_from_robot) frame->wMc = to_eigen(robot.wMc());
+      const double gap = last_stamp ? frame->timestamp - *last_stamp : 0.0;
+      const double dt = last_stamp ? gap : options.first_period;
+      last_stamp = frame->timestamp;
+
+      RobotLoopFrame out;
+      out.index = summary.frames;
+      out.frame = &*frame;
+      out.dt = dt;
+      std::optional<ViewProblem> problem;
+      PerceptionResult result;
+      if (options.problem_source) {
+        problem = options.problem_source(*frame);
+      } else {
+        result = perception->process(*frame);
+        if (result.status != TrackingStatus::Lost) problem = result.problem;
+        out.perception = &result;
+      }
+      out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
+      out.frame_age = options.wall_clock_age ? out.perception_s : gap;
+      const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age);
+      out.step = &step;
+      summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
+      if (options.move_robot) (void)robot.step(step.velocity, dt);
+      ++summary.frames;
+      if (observer) observer(out);
+    }
+  } catch (...) {
+    rest();
+    throw;
+  }
+  summary.stopped = options.stop != nullptr && *options.stop != 0;
+  rest();
+  return summary;
+}
+
+}  // namespace ofv

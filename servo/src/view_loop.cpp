@@ -1,0 +1,213 @@
+// The per-frame policy: view selection, target continuity, control, safety.
+#include "ofv/servo/view_loop.h"
+
+#include "ofv/estimator_settings.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace ofv {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+
+// `none`, or xmin,ymin,zmin,xmax,ymax,zmax [m].
+Eigen::AlignedBox3d parse_workspace(const std::string& value) {
+  if (value == "none") return {};
+  std::istringstream in(value);
+  double v[6];
+  char comma = ',';
+  for (int i = 0; i < 6; ++i) {
+    if ((i > 0 && !(in >> comma)) || comma != ',' || !(in >> v[i]) || !std::isfinite(v[i])) {
+      throw std::invalid_argument("setting 'workspace' must be none or six numbers xmin,ymin,zmin,xmax,ymax,zmax, got \"" +
+                                  value + "\"");
+    }
+  }
+  in >> std::ws;
+  const Eigen::AlignedBox3d box(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]));
+  if (!in.eof() || box.isEmpty()) {
+    throw std::invalid_argument("setting 'workspace' must be none or a non-empty box xmin,ymin,zmin,xmax,ymax,zmax, got \"" +
+                                value + "\"");
+  }
+  return box;
+}
+
+SettingsTable<LoopSettings> make_table() {
+  using L = LoopSettings;
+  const LoopSettings d;
+  SettingsTable<L> t;
+  t.include(estimator_settings_table(), [](L& l) -> EstimatorParams& { return l.estimator; });
+  t.add({"method", "estimator | static | initial_view | sampling", to_string(d.method), "",
+         "how the target view is chosen: the occlusion-free view, or a baseline"},
+        [](L& l, const std::string& v) {
+          l.method = parse_word<ViewMethod>("method", v,
+                                            {{"estimator", ViewMethod::Estimator},
+                                             {"static", ViewMethod::Static},
+                                             {"initial_view", ViewMethod::InitialView},
+                                             {"sampling", ViewMethod::Sampling}});
+        });
+  t.add({"sampling_candidates", "integer", std::to_string(d.sampling.candidates), "",
+         "candidate views on the sphere of method=sampling (Fibonacci lattice), 1 to 1e6"},
+        [](L& l, const std::string& v) {
+          l.sampling.candidates = static_cast<int>(parse_integer("sampling_candidates", v, 1, 1000000));
+        });
+  t.add({"sampling_occluder_radius", "number", format_number(d.sampling.occluder_radius), "m",
+         "method=sampling: an occluder point blocks lines of sight passing closer than this"},
+        [](L& l, const std::string& v) {
+          l.sampling.occluder_radius = parse_number("sampling_occluder_radius", v, 0.0, 1.0, true);
+        });
+  t.add({"controller", "sphere | pbvs", d.controller.law == ControllerSettings::Law::Sphere ? "sphere" : "pbvs", "",
+         "sphere: FeatureSphereView, along the sphere with the object centred; pbvs: straight to the target pose"},
+        [](L& l, const std::string& v) {
+          l.controller.law = parse_word<ControllerSettings::Law>(
+              "controller", v, {{"sphere", ControllerSettings::Law::Sphere}, {"pbvs", ControllerSettings::Law::Pbvs}});
+        });
+  t.add({"gain", "number", format_number(d.controller.gain), "1/s",
+         "lambda: the error decays as exp(-gain t) until the speed limits bind"},
+        [](L& l, const std::string& v) { l.controller.gain = parse_number("gain", v, 0.0, 100.0, true); });
+  t.add({"adaptive_gain", "bool", format_bool(d.controller.adaptive_gain), "",
+         "twice the gain near zero error, the gain far away (vpAdaptiveGain)"},
+        [](L& l, const std::string& v) { l.controller.adaptive_gain = parse_bool("adaptive_gain", v); });
+  t.add({"max_linear_speed", "number", format_number(d.controller.max_linear_speed), "m/s",
+         "the controller scales the linear velocity down to this; the safety filter enforces it"},
+        [](L& l, const std::string& v) {
+          l.controller.max_linear_speed = l.safety.max_linear_speed = parse_number("max_linear_speed", v, 0.0, 10.0, true);
+        });
+  t.add({"max_angular_speed", "number", format_number(d.controller.max_angular_speed), "rad/s",
+         "the controller scales the angular velocity down to this; the safety filter enforces it"},
+        [](L& l, const std::string& v) {
+          l.controller.max_angular_speed = l.safety.max_angular_speed =
+              parse_number("max_angular_speed", v, 0.0, 20.0, true);
+        });
+  t.add({"target_filter", "number", format_number(d.controller.target_filter), "s",
+         "time constant of a low-pass on the target position; 0 = off"},
+        [](L& l, const std::string& v) { l.controller.target_filter = parse_number("target_filter", v, 0.0, 10.0, false); });
+  t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",
+         "while t0 is occluded, continue from the previous target (warm start) instead of re-estimating from t0"},
+        [](L& l, const std::string& v) { l.target_hysteresis = parse_bool("target_hysteresis", v); });
+  t.add({"max_linear_accel", "number", format_number(d.safety.max_linear_accel), "m/s^2",
+         "safety filter: largest change of the linear velocity"},
+        [](L& l, const std::string& v) { l.safety.max_linear_accel = parse_number("max_linear_accel", v, 0.0, 100.0, true); });
+  t.add({"max_angular_accel", "number", format_number(d.safety.max_angular_accel), "rad/s^2",
+         "safety filter: largest change of the angular velocity"},
+        [](L& l, const std::string& v) {
+          l.safety.max_angular_accel = parse_number("max_angular_accel", v, 0.0, 1000.0, true);
+        });
+  t.add({"stale_timeout", "number", format_number(d.safety.stale_timeout), "s",
+         "safety filter: a frame older than this when its command is sent stops the robot"},
+        [](L& l, const std::string& v) { l.safety.stale_timeout = parse_number("stale_timeout", v, 0.0, 60.0, true); });
+  t.add({"workspace", "none | xmin,ymin,zmin,xmax,ymax,zmax", "none", "m",
+         "safety filter: the camera stays inside this box (world frame)"},
+        [](L& l, const std::string& v) { l.safety.workspace = parse_workspace(v); });
+  return t;
+}
+
+}  // namespace
+
+const SettingsTable<LoopSettings>& loop_settings_table() {
+  static const SettingsTable<LoopSettings> table = make_table();
+  return table;
+}
+
+const char* to_string(StepStatus status) {
+  switch (status) {
+    case StepStatus::Converged: return "converged";
+    case StepStatus::NotConverged: return "not_converged";
+    case StepStatus::NoOccluders: return "no_occluders";
+    case StepStatus::ObjectLost: return "object_lost";
+  }
+  return "?";
+}
+
+ViewLoop::ViewLoop(const LoopSettings& settings)
+    : settings_(settings),
+      estimator_(settings.estimator.resolve()),
+      controller_(settings.controller),
+      safety_(settings.safety) {
+  if (settings_.sampling.candidates < 1 || !(settings_.sampling.occluder_radius > 0.0)) {
+    throw std::invalid_argument("sampling settings: candidates must be >= 1 and occluder_radius positive");
+  }
+}
+
+void ViewLoop::reset() {
+  previous_view_.reset();
+  previous_target_.reset();
+  controller_.reset();
+  safety_.reset();
+}
+
+std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& problem, const ViewEstimate& estimate) {
+  const double r_sphere = estimator_.r_sphere;
+  std::optional<Eigen::Vector3d> target;
+  switch (settings_.method) {
+    case ViewMethod::Estimator: target = estimate.tf; break;
+    case ViewMethod::InitialView: target = estimate.t0; break;
+    case ViewMethod::Sampling: target = sample_best_view(problem, estimate.centroid, r_sphere, settings_.sampling).view; break;
+    case ViewMethod::Static: return std::nullopt;
+  }
+  if (settings_.target_hysteresis && previous_target_) {
+    if (settings_.method == ViewMethod::Estimator && estimate.iterations > 0) {
+      // t0 is occluded: continue from the previous target (the spec's warm
+      // start), which stays where it is while clear and otherwise moves to
+      // the nearest clear view. While t0 is clear, t0 is the target.
+      ViewProblem from_previous = problem;
+      from_previous.previous_view = *previous_target_;
+      EstimatorSettings warm = estimator_;
+      warm.warm_start = true;
+      const ViewEstimate kept = estimate_view(from_previous, warm);
+      if (kept.status != ViewStatus::NotConverged) target = kept.tf;
+    } else if (settings_.method == ViewMethod::Sampling) {
+      // Keep the previous view while it sees as much as the new best.
+      const Eigen::Vector3d previous = estimate.centroid + r_sphere * (*previous_target_ - estimate.centroid).normalized();
+      const double rho = settings_.sampling.occluder_radius;
+      if (score_view(problem, estimate.centroid, r_sphere, previous, rho).visible_fraction >=
+          score_view(problem, estimate.centroid, r_sphere, *target, rho).visible_fraction) {
+        target = previous;
+      }
+    }
+  }
+  return target;
+}
+
+LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
+                        double frame_age) {
+  LoopStep out;
+  auto start = Clock::now();
+  if (problem) {
+    problem->camera = Eigen::Vector3d(wMc[0][3], wMc[1][3], wMc[2][3]);
+    problem->previous_view = previous_view_;
+    out.estimate = estimate_view(*problem, estimator_);
+    if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
+  }
+  if (out.estimate) {
+    switch (out.estimate->status) {
+      case ViewStatus::Converged: out.status = StepStatus::Converged; break;
+      case ViewStatus::NotConverged: out.status = StepStatus::NotConverged; break;
+      default: out.status = StepStatus::NoOccluders; break;
+    }
+    out.target = choose_target(*problem, *out.estimate);
+    previous_view_ = out.estimate->tf;
+    previous_target_ = out.target;
+  }
+  out.estimate_s = seconds_since(start);
+
+  start = Clock::now();
+  if (out.target) {
+    out.command = controller_.update(*out.target, out.estimate->centroid, estimator_.r_sphere, wMc, dt);
+  }
+  out.velocity = safety_.filter(out.command, wMc, dt, out.estimate.has_value(), frame_age);
+  out.safety = safety_.last_action();
+  out.control_s = seconds_since(start);
+  return out;
+}
+
+}  // namespace ofv
