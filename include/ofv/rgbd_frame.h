@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -24,6 +25,19 @@ struct CameraIntrinsics {
   double cx = 320.0;  ///< principal point x [px]
   double cy = 240.0;  ///< principal point y [px]
 };
+
+/// \brief Depth counts per metre in TUM RGB-D recordings (16-bit PNG, value / 5000 = metres).
+inline constexpr double kTumDepthFactor = 5000.0;
+
+/// \brief A depth [m] as a 16-bit count of 1/`factor` m; 0 for missing, non-finite or out of range.
+[[nodiscard]] inline std::uint16_t depth_to_units(double z, double factor) {
+  const double value = z > 0.0 && z * factor < 65535.5 ? std::round(z * factor) : 0.0;  // NaN fails z > 0
+  return static_cast<std::uint16_t>(value);
+}
+/// \brief The depth [m] a 16-bit count stands for, exactly as every reader of ofv computes it.
+[[nodiscard]] inline float depth_from_units(std::uint16_t units, double factor) {
+  return static_cast<float>(units) * static_cast<float>(1.0 / factor);
+}
 
 /// \brief Depth, colour and pose of one frame. Images are row-major, width x height.
 struct RgbdFrame {

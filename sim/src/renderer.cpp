@@ -261,11 +261,19 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
     for (auto& t : pool) t.join();
   };
   in_parallel(render_rows);
-  if (!noise) return out;
+  if (noise) add_noise(f, cos_incidence, sensor.noise, frame_index, in_parallel);
+  // Sensors and recordings store depth as 16-bit counts: so does the
+  // simulated sensor, so that a recorded episode replays bit for bit.
+  for (float& z : f.depth) z = depth_from_units(depth_to_units(z, kTumDepthFactor), kTumDepthFactor);
+  return out;
+}
+
+void Renderer::add_noise(RgbdFrame& f, const std::vector<float>& cos_incidence, const NoiseModel& m,
+                         long frame_index, const ParallelRows& in_parallel) const {
+  const CameraIntrinsics& k = f.intrinsics;
 
   // A generator per row, seeded from (scenario seed, frame, row): the same
   // frame whatever the thread count.
-  const NoiseModel& m = sensor.noise;
   const float cos_grazing = static_cast<float>(std::cos(m.grazing_deg * kDegToRad));
   const std::vector<float> clean = f.depth;
   in_parallel([&](int row0, int row1) {
@@ -295,7 +303,6 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
       }
     }
   });
-  return out;
 }
 
 ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {

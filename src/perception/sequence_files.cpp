@@ -56,7 +56,7 @@ std::string format_pose_line(double time, const Eigen::Isometry3d& wMc) {
   const Eigen::Quaterniond q(wMc.linear());
   const Eigen::Vector3d t = wMc.translation();
   char buffer[256];
-  std::snprintf(buffer, sizeof buffer, "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", time, t.x(),
+  std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", time, t.x(),
                 t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   return buffer;
 }
@@ -69,6 +69,9 @@ Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double
   }
   if (after == poses.end()) {
     return poses.back().wMc;
+  }
+  if (after->time == time) {
+    return after->wMc;  // a frame's own pose, exactly
   }
   const StampedPose& b = *after;
   const StampedPose& a = *(after - 1);

@@ -110,11 +110,10 @@ std::optional<RgbdFrame> TumSequenceSource::next() {
                              std::to_string(intrinsics_.height));
   }
   f.depth.resize(static_cast<std::size_t>(depth.total()));
-  const auto scale = static_cast<float>(1.0 / options_.depth_factor);
   for (int v = 0; v < depth.rows; ++v) {
     const auto* row = depth.ptr<std::uint16_t>(v);
     for (int u = 0; u < depth.cols; ++u) {
-      f.depth[f.index(u, v)] = static_cast<float>(row[u]) * scale;
+      f.depth[f.index(u, v)] = depth_from_units(row[u], options_.depth_factor);
     }
   }
   if (!e.rgb.empty()) {
@@ -173,8 +172,10 @@ void TumSequenceWriter::write(const RgbdFrame& frame) {
   }
   const int w = frame.intrinsics.width;
   const int h = frame.intrinsics.height;
-  char stamp[64];
+  char stamp[64];  // file names: microseconds; lists and poses: every digit, so a replay has the same times
   std::snprintf(stamp, sizeof stamp, "%.6f", frame.timestamp);
+  char time[64];
+  std::snprintf(time, sizeof time, "%.17g", frame.timestamp);
   const std::string depth_name = std::string("depth/") + stamp + ".png";
   const std::string rgb_name = std::string("rgb/") + stamp + ".png";
 
@@ -182,15 +183,13 @@ void TumSequenceWriter::write(const RgbdFrame& frame) {
   for (int v = 0; v < h; ++v) {
     auto* row = depth.ptr<std::uint16_t>(v);
     for (int u = 0; u < w; ++u) {
-      const double z = frame.depth[frame.index(u, v)];
-      const double value = std::isfinite(z) && z > 0.0 ? std::round(z * depth_factor_) : 0.0;
-      row[u] = value <= 65535.0 ? static_cast<std::uint16_t>(value) : 0;
+      row[u] = depth_to_units(frame.depth[frame.index(u, v)], depth_factor_);
     }
   }
   if (!cv::imwrite((dir / depth_name).string(), depth)) {
     throw std::runtime_error((dir / depth_name).string() + ": cannot write");
   }
-  std::ofstream(dir / "depth.txt", std::ios::app) << stamp << ' ' << depth_name << '\n';
+  std::ofstream(dir / "depth.txt", std::ios::app) << time << ' ' << depth_name << '\n';
   if (!frame.rgb.empty()) {
     const cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
     cv::Mat bgr;
@@ -198,7 +197,7 @@ void TumSequenceWriter::write(const RgbdFrame& frame) {
     if (!cv::imwrite((dir / rgb_name).string(), bgr)) {
       throw std::runtime_error((dir / rgb_name).string() + ": cannot write");
     }
-    std::ofstream(dir / "rgb.txt", std::ios::app) << stamp << ' ' << rgb_name << '\n';
+    std::ofstream(dir / "rgb.txt", std::ios::app) << time << ' ' << rgb_name << '\n';
   }
   std::ofstream(dir / "groundtruth.txt", std::ios::app)
       << format_pose_line(frame.timestamp, frame.wMc);

@@ -14,6 +14,7 @@
 #include "ofv/sim/scenario.h"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -86,6 +87,11 @@ class Renderer {
   [[nodiscard]] const Scenario& scenario() const { return scenario_; }
 
  private:
+  using ParallelRows = std::function<void(const std::function<void(int, int)>&)>;
+  // Depth noise and dropouts (NoiseModel), per row from (seed, frame, row).
+  void add_noise(RgbdFrame& f, const std::vector<float>& cos_incidence, const NoiseModel& m, long frame_index,
+                 const ParallelRows& in_parallel) const;
+
   struct Impl;
   Scenario scenario_;
   double time_ = -1.0;
