@@ -4,41 +4,12 @@
 
 #include "ofv/loop/compare.h"
 #include "ofv/loop/episode.h"
+#include "ofv/loop/scenario_set.h"
 
-#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <thread>
-
-#include <unistd.h>
 
 namespace ofv::cli {
-
-namespace {
-
-namespace fs = std::filesystem;
-
-// Scenario names and paths from files, folders (their *.yaml) and built-in names.
-std::vector<std::pair<std::string, std::string>> scenario_list(const std::vector<std::string>& args) {
-  std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& a : args) {
-    if (fs::is_directory(a)) {
-      std::vector<fs::path> files;
-      for (const auto& e : fs::directory_iterator(a)) {
-        if (e.path().extension() == ".yaml") files.push_back(e.path());
-      }
-      std::sort(files.begin(), files.end());
-      if (files.empty()) throw std::invalid_argument("--scenarios " + a + ": no .yaml scenario in this folder");
-      for (const auto& f : files) out.emplace_back(f.stem().string(), f.string());
-    } else {
-      const sim::Scenario s = sim::load_scenario(a);  // validates, and resolves built-in names
-      out.emplace_back(s.name, s.path);
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 Command add_compare_command(CLI::App& app) {
   struct Options {
@@ -81,27 +52,12 @@ Command add_compare_command(CLI::App& app) {
               Grid grid = read_grid(opt->grid);
               if (opt->seeds < 0) throw std::invalid_argument("--seeds must be >= 1");
               if (opt->seeds > 0) grid.seeds = opt->seeds;
-              const auto scenarios = scenario_list(opt->scenarios);
-              // Every variant's settings must be valid on every scenario before anything runs.
-              for (const auto& [name, path] : scenarios) {
-                const sim::Scenario s = sim::load_scenario(path);
-                for (const auto& v : grid.variants) {
-                  try {
-                    (void)resolve_episode(s, v.settings);
-                  } catch (const std::invalid_argument& e) {
-                    throw std::invalid_argument(opt->grid + ": variant '" + v.name + "': " + e.what());
-                  }
-                }
-              }
+              const auto scenarios = scenario_set(opt->scenarios);
+              check_grid(scenarios, grid, opt->grid);
               episodes = plan_episodes(scenarios, grid);
               if (!opt->shard.empty()) {
-                int k = 0, n = 0;
-                char slash = 0;
-                std::istringstream in(opt->shard);
-                if (!(in >> k >> slash >> n) || slash != '/' || !in.eof()) {
-                  throw std::invalid_argument("--shard " + opt->shard + ": expected K/N, e.g. 2/8");
-                }
-                episodes = shard(episodes, k, n);
+                const Shard part = parse_shard(opt->shard);
+                episodes = shard(episodes, part.k, part.n);
               }
               if (opt->jobs < 0) throw std::invalid_argument("--jobs must be >= 1");
             } catch (const std::invalid_argument& e) {
@@ -110,8 +66,8 @@ Command add_compare_command(CLI::App& app) {
             }
             try {
               SweepOptions options;
-              options.jobs = opt->jobs > 0 ? opt->jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-              options.progress = isatty(2) != 0;
+              options.jobs = opt->jobs;  // 0: one per core
+              options.progress = true;   // drawn only on a terminal
               const int ran = run_sweep(episodes, simulation_runner(), opt->out, options);
               const auto rows = load_episodes({opt->out});
               const auto plots = write_reports(rows, opt->out);

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -118,6 +119,28 @@ TEST(Grid, ShardsPartitionTheSweep) {
   EXPECT_THROW((void)shard(all, 5, 4), std::invalid_argument);
 }
 
+TEST(Grid, ShardTextIsKOverN) {
+  const Shard s = parse_shard("2/8");
+  EXPECT_EQ(s.k, 2);
+  EXPECT_EQ(s.n, 8);
+  for (const std::string text : {"2-8", "2/8x", "/8", "two/8"}) {
+    try {
+      (void)parse_shard(text);
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Reports, CsvFieldsAreQuotedOnlyWhenNeeded) {
+  EXPECT_EQ(csv_field("paper"), "paper");
+  EXPECT_EQ(csv_field("a,b"), "\"a,b\"");
+  EXPECT_EQ(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+  EXPECT_EQ(csv_number(std::nan("")), "");
+  EXPECT_EQ(csv_number(2.0 / 3.0, 3), "0.667");
+}
+
 TEST(Interval95, StudentT) {
   const Interval i = mean_interval({1.0, 2.0, 3.0});
   EXPECT_DOUBLE_EQ(i.mean, 2.0);
@@ -167,6 +190,27 @@ TEST_F(Compare, AnInterruptedSweepResumes) {
   };
   EXPECT_EQ(run_sweep(all, counts, dir_.string(), {2, false}), static_cast<int>(all.size()) - 5);
   EXPECT_EQ(reruns, static_cast<int>(all.size()) - 5);
+  EXPECT_EQ(load_episodes({dir_.string()}).size(), all.size());
+}
+
+TEST_F(Compare, AFailedEpisodeIsNamedAndTheOthersAreKept) {
+  const auto all = plan();
+  const std::string failing = all[7].id();
+  const EpisodeRunner fails = [&](const EpisodeSpec& s) {
+    if (s.id() == failing) throw std::runtime_error("diverged");
+    return synthetic(s);
+  };
+  try {
+    run_sweep(all, fails, dir_.string(), {2, false});
+    ADD_FAILURE() << "the failure was not reported";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(failing), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("diverged"), std::string::npos) << e.what();
+  }
+  // Whatever finished is on disk, and a rerun completes the sweep.
+  const std::size_t kept = load_episodes({dir_.string()}).size();
+  EXPECT_LT(kept, all.size());
+  EXPECT_EQ(run_sweep(all, synthetic, dir_.string(), {0, false}), static_cast<int>(all.size() - kept));
   EXPECT_EQ(load_episodes({dir_.string()}).size(), all.size());
 }
 
