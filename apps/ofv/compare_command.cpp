@@ -34,37 +34,42 @@ Command add_compare_command(CLI::App& app) {
               "episodes.csv, summary.csv, summary.md and plots/*.png.");
 
   return {sub, [opt]() -> int {
+            // Usage errors (exit 2) are all found before anything runs or is written.
+            std::vector<EpisodeRow> merged;
             std::vector<EpisodeSpec> episodes;
             try {
               if (!opt->merge.empty()) {
                 if (!opt->scenarios.empty() || !opt->grid.empty()) {
                   throw std::invalid_argument("--merge takes no --scenarios or --grid");
                 }
-                const auto rows = load_episodes(opt->merge);
-                const auto plots = write_reports(rows, opt->out);
-                std::cout << "ofv compare: merged " << rows.size() << " episodes from " << opt->merge.size()
-                          << " runs into " << opt->out << "/summary.md (" << plots.size() << " plots)\n";
-                return kOk;
+                merged = load_episodes(opt->merge);
+              } else {
+                if (opt->scenarios.empty() || opt->grid.empty()) {
+                  throw std::invalid_argument("--scenarios and --grid are required (or --merge DIRS)");
+                }
+                Grid grid = read_grid(opt->grid);
+                if (opt->seeds < 0) throw std::invalid_argument("--seeds must be >= 1");
+                if (opt->seeds > 0) grid.seeds = opt->seeds;
+                const auto scenarios = scenario_set(opt->scenarios);
+                check_grid(scenarios, grid, opt->grid);
+                episodes = plan_episodes(scenarios, grid);
+                if (!opt->shard.empty()) {
+                  const Shard part = parse_shard(opt->shard);
+                  episodes = shard(episodes, part.k, part.n);
+                }
+                if (opt->jobs < 0) throw std::invalid_argument("--jobs must be >= 1");
               }
-              if (opt->scenarios.empty() || opt->grid.empty()) {
-                throw std::invalid_argument("--scenarios and --grid are required (or --merge DIRS)");
-              }
-              Grid grid = read_grid(opt->grid);
-              if (opt->seeds < 0) throw std::invalid_argument("--seeds must be >= 1");
-              if (opt->seeds > 0) grid.seeds = opt->seeds;
-              const auto scenarios = scenario_set(opt->scenarios);
-              check_grid(scenarios, grid, opt->grid);
-              episodes = plan_episodes(scenarios, grid);
-              if (!opt->shard.empty()) {
-                const Shard part = parse_shard(opt->shard);
-                episodes = shard(episodes, part.k, part.n);
-              }
-              if (opt->jobs < 0) throw std::invalid_argument("--jobs must be >= 1");
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv compare: " << e.what() << '\n';
               return kUsage;
             }
             try {
+              if (!opt->merge.empty()) {
+                const auto plots = write_reports(merged, opt->out);
+                std::cout << "ofv compare: merged " << merged.size() << " episodes from " << opt->merge.size()
+                          << " runs into " << opt->out << "/summary.md (" << plots.size() << " plots)\n";
+                return kOk;
+              }
               SweepOptions options;
               options.jobs = opt->jobs;  // 0: one per core
               options.progress = true;   // drawn only on a terminal
