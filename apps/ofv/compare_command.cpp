@@ -4,41 +4,12 @@
 
 #include "ofv/loop/compare.h"
 #include "ofv/loop/episode.h"
+#include "ofv/loop/scenario_set.h"
 
-#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <thread>
-
-#include <unistd.h>
 
 namespace ofv::cli {
-
-namespace {
-
-namespace fs = std::filesystem;
-
-// Scenario names and paths from files, folders (their *.yaml) and built-in names.
-std::vector<std::pair<std::string, std::string>> scenario_list(const std::vector<std::string>& args) {
-  std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& a : args) {
-    if (fs::is_directory(a)) {
-      std::vector<fs::path> files;
-      for (const auto& e : fs::directory_iterator(a)) {
-        if (e.path().extension() == ".yaml") files.push_back(e.path());
-      }
-      std::sort(files.begin(), files.end());
-      if (files.empty()) throw std::invalid_argument("--scenarios " + a + ": no .yaml scenario in this folder");
-      for (const auto& f : files) out.emplace_back(f.stem().string(), f.string());
-    } else {
-      const sim::Scenario s = sim::load_scenario(a);  // validates, and resolves built-in names
-      out.emplace_back(s.name, s.path);
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 Command add_compare_command(CLI::App& app) {
   struct Options {
@@ -63,55 +34,45 @@ Command add_compare_command(CLI::App& app) {
               "episodes.csv, summary.csv, summary.md and plots/*.png.");
 
   return {sub, [opt]() -> int {
+            // Usage errors (exit 2) are all found before anything runs or is written.
+            std::vector<EpisodeRow> merged;
             std::vector<EpisodeSpec> episodes;
             try {
               if (!opt->merge.empty()) {
                 if (!opt->scenarios.empty() || !opt->grid.empty()) {
                   throw std::invalid_argument("--merge takes no --scenarios or --grid");
                 }
-                const auto rows = load_episodes(opt->merge);
-                const auto plots = write_reports(rows, opt->out);
-                std::cout << "ofv compare: merged " << rows.size() << " episodes from " << opt->merge.size()
-                          << " runs into " << opt->out << "/summary.md (" << plots.size() << " plots)\n";
-                return kOk;
-              }
-              if (opt->scenarios.empty() || opt->grid.empty()) {
-                throw std::invalid_argument("--scenarios and --grid are required (or --merge DIRS)");
-              }
-              Grid grid = read_grid(opt->grid);
-              if (opt->seeds < 0) throw std::invalid_argument("--seeds must be >= 1");
-              if (opt->seeds > 0) grid.seeds = opt->seeds;
-              const auto scenarios = scenario_list(opt->scenarios);
-              // Every variant's settings must be valid on every scenario before anything runs.
-              for (const auto& [name, path] : scenarios) {
-                const sim::Scenario s = sim::load_scenario(path);
-                for (const auto& v : grid.variants) {
-                  try {
-                    (void)resolve_episode(s, v.settings);
-                  } catch (const std::invalid_argument& e) {
-                    throw std::invalid_argument(opt->grid + ": variant '" + v.name + "': " + e.what());
-                  }
+                merged = load_episodes(opt->merge);
+              } else {
+                if (opt->scenarios.empty() || opt->grid.empty()) {
+                  throw std::invalid_argument("--scenarios and --grid are required (or --merge DIRS)");
                 }
-              }
-              episodes = plan_episodes(scenarios, grid);
-              if (!opt->shard.empty()) {
-                int k = 0, n = 0;
-                char slash = 0;
-                std::istringstream in(opt->shard);
-                if (!(in >> k >> slash >> n) || slash != '/' || !in.eof()) {
-                  throw std::invalid_argument("--shard " + opt->shard + ": expected K/N, e.g. 2/8");
+                Grid grid = read_grid(opt->grid);
+                if (opt->seeds < 0) throw std::invalid_argument("--seeds must be >= 1");
+                if (opt->seeds > 0) grid.seeds = opt->seeds;
+                const auto scenarios = scenario_set(opt->scenarios);
+                check_grid(scenarios, grid, opt->grid);
+                episodes = plan_episodes(scenarios, grid);
+                if (!opt->shard.empty()) {
+                  const Shard part = parse_shard(opt->shard);
+                  episodes = shard(episodes, part.k, part.n);
                 }
-                episodes = shard(episodes, k, n);
+                if (opt->jobs < 0) throw std::invalid_argument("--jobs must be >= 1");
               }
-              if (opt->jobs < 0) throw std::invalid_argument("--jobs must be >= 1");
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv compare: " << e.what() << '\n';
               return kUsage;
             }
             try {
+              if (!opt->merge.empty()) {
+                const auto plots = write_reports(merged, opt->out);
+                std::cout << "ofv compare: merged " << merged.size() << " episodes from " << opt->merge.size()
+                          << " runs into " << opt->out << "/summary.md (" << plots.size() << " plots)\n";
+                return kOk;
+              }
               SweepOptions options;
-              options.jobs = opt->jobs > 0 ? opt->jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-              options.progress = isatty(2) != 0;
+              options.jobs = opt->jobs;  // 0: one per core
+              options.progress = true;   // drawn only on a terminal
               const int ran = run_sweep(episodes, simulation_runner(), opt->out, options);
               const auto rows = load_episodes({opt->out});
               const auto plots = write_reports(rows, opt->out);

@@ -1,8 +1,10 @@
-// The comparison harness with a synthetic, deterministic episode runner.
+// The comparison sweep (planning, shards, parallel resumable runs, merge)
+// with a synthetic, deterministic episode runner.
 #include "ofv/loop/compare.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -61,52 +63,6 @@ class Compare : public testing::Test {
   fs::path dir_;
 };
 
-TEST(Grid, VariantsAndAxesExpandToTheirProduct) {
-  const Grid g = grid_from_yaml(R"(
-name: readings
-seeds: 2
-variants:
-  - name: paper
-    set: {preset: paper}
-  - name: authors
-    set: {preset: authors_code, step: 0.01}
-axes:
-  push_radius: [r_sphere, r_seed]
-  method: [estimator, sampling]
-)", "grid.yaml");
-  EXPECT_EQ(g.name, "readings");
-  EXPECT_EQ(g.seeds, 2);
-  ASSERT_EQ(g.variants.size(), 8U);
-  EXPECT_EQ(g.variants[0].name, "paper,push_radius=r_sphere,method=estimator");
-  ASSERT_EQ(g.variants[7].settings.size(), 4U);
-  EXPECT_EQ(g.variants[7].settings[1], (std::pair<std::string, std::string>("step", "0.01")));
-  EXPECT_EQ(g.variants[7].settings[3].second, "sampling");
-}
-
-TEST(Grid, ErrorsNameFileAndKey) {
-  const std::vector<std::pair<std::string, std::string>> cases{
-      {"seeds: -1", "seeds"},
-      {"seeds: many", "seeds"},
-      {"colour: red", "colour"},
-      {"variants: {a: 1}", "variants"},
-      {"variants:\n  - set: {step: 1}", "variants[0].name"},
-      {"variants:\n  - name: a\n    sett: {}", "variants[0].sett"},
-      {"variants:\n  - name: a\n  - name: a", "used twice"},
-      {"axes:\n  step: []", "axes.step"},
-      {"axes:\n  step: [[1]]", "axes.step[0]"},
-      {"[1, 2", "invalid YAML"},
-  };
-  for (const auto& [text, mention] : cases) {
-    try {
-      (void)grid_from_yaml(text, "g.yaml");
-      ADD_FAILURE() << text << " was accepted";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("g.yaml"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
-    }
-  }
-}
-
 TEST(Grid, ShardsPartitionTheSweep) {
   const Grid g = grid_from_yaml("seeds: 5\naxes:\n  gain: [1, 2, 3]", "g");
   const auto all = plan_episodes({{"a", "a"}, {"b", "b"}}, g);
@@ -118,14 +74,18 @@ TEST(Grid, ShardsPartitionTheSweep) {
   EXPECT_THROW((void)shard(all, 5, 4), std::invalid_argument);
 }
 
-TEST(Interval95, StudentT) {
-  const Interval i = mean_interval({1.0, 2.0, 3.0});
-  EXPECT_DOUBLE_EQ(i.mean, 2.0);
-  EXPECT_NEAR(i.half_width, 4.303 * 1.0 / std::sqrt(3.0), 1e-9);
-  EXPECT_EQ(mean_interval({std::nan(""), 4.0}).n, 1);
-  // Equal up to rounding (2.1 - 1.7666... vs 2.4333... - 2.1): no interval.
-  EXPECT_EQ(mean_interval({2.1 - 53.0 / 30.0, 73.0 / 30.0 - 2.1}).half_width, 0.0);
-  EXPECT_GT(mean_interval({0.3, 0.3 + 1e-9}).half_width, 0.0);
+TEST(Sweep, ShardTextIsKOverN) {
+  const Shard s = parse_shard("2/8");
+  EXPECT_EQ(s.k, 2);
+  EXPECT_EQ(s.n, 8);
+  for (const std::string text : {"2-8", "2/8x", "/8", "two/8"}) {
+    try {
+      (void)parse_shard(text);
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST_F(Compare, ResultsDoNotDependOnTheJobCount) {
@@ -167,6 +127,27 @@ TEST_F(Compare, AnInterruptedSweepResumes) {
   };
   EXPECT_EQ(run_sweep(all, counts, dir_.string(), {2, false}), static_cast<int>(all.size()) - 5);
   EXPECT_EQ(reruns, static_cast<int>(all.size()) - 5);
+  EXPECT_EQ(load_episodes({dir_.string()}).size(), all.size());
+}
+
+TEST_F(Compare, AFailedEpisodeIsNamedAndTheOthersAreKept) {
+  const auto all = plan();
+  const std::string failing = all[7].id();
+  const EpisodeRunner fails = [&](const EpisodeSpec& s) {
+    if (s.id() == failing) throw std::runtime_error("diverged");
+    return synthetic(s);
+  };
+  try {
+    run_sweep(all, fails, dir_.string(), {2, false});
+    ADD_FAILURE() << "the failure was not reported";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(failing), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("diverged"), std::string::npos) << e.what();
+  }
+  // Whatever finished is on disk, and a rerun completes the sweep.
+  const std::size_t kept = load_episodes({dir_.string()}).size();
+  EXPECT_LT(kept, all.size());
+  EXPECT_EQ(run_sweep(all, synthetic, dir_.string(), {0, false}), static_cast<int>(all.size() - kept));
   EXPECT_EQ(load_episodes({dir_.string()}).size(), all.size());
 }
 

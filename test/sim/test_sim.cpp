@@ -182,11 +182,13 @@ TEST(Renderer, DepthOfAPlaneMatchesTheAnalyticValue) {
   const Scenario s = scenario_from_yaml(
       "sensor: {noise: {enabled: false}}\nobject: {shape: box, size: [1, 1, 0.01], position: [0, 0, 1]}", kSource);
   Renderer r(s);
+  // The sensor stores depth in counts of 1/5000 m, as TUM recordings do.
+  const auto stored = [](double z) { return depth_from_units(depth_to_units(z, kTumDepthFactor), kTumDepthFactor); };
   // Straight on: every pixel on the wall sees its front face at z = 0.995.
   RenderedFrame f = r.render(s.wMc_start, 0);
   const CameraIntrinsics& k = f.frame.intrinsics;
-  EXPECT_NEAR(f.frame.depth[f.frame.index(160, 120)], 0.995, 1e-5);
-  EXPECT_NEAR(f.frame.depth[f.frame.index(170, 130)], 0.995, 1e-5);
+  EXPECT_EQ(f.frame.depth[f.frame.index(160, 120)], stored(0.995));
+  EXPECT_EQ(f.frame.depth[f.frame.index(170, 130)], stored(0.995));
   // Tilted camera about x by 5 degrees: depth along each ray is analytic.
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
   wMc.linear() = Eigen::AngleAxisd(5.0 * 3.14159265358979 / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
@@ -194,7 +196,7 @@ TEST(Renderer, DepthOfAPlaneMatchesTheAnalyticValue) {
   for (const auto& [u, v] : {std::pair{160, 120}, std::pair{150, 100}, std::pair{170, 140}}) {
     const Eigen::Vector3d ray_w = wMc.linear() * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
     const double expected = 0.995 / ray_w.z();  // Z of the hit along a unit-Z camera ray
-    EXPECT_NEAR(f.frame.depth[f.frame.index(u, v)], expected, 1e-5) << u << "," << v;
+    EXPECT_EQ(f.frame.depth[f.frame.index(u, v)], stored(expected)) << u << "," << v;
   }
 }
 

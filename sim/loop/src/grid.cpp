@@ -1,0 +1,133 @@
+// The settings grid of `ofv compare`: YAML to a list of named variants.
+#include "ofv/loop/grid.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace ofv {
+
+namespace {
+
+[[noreturn]] void grid_error(const std::string& source, const std::string& key,
+                             const std::string& what) {
+  throw std::invalid_argument(source + ": " + key + ": " + what);
+}
+
+std::string scalar_text(const YAML::Node& n, const std::string& source, const std::string& key) {
+  if (!n.IsScalar()) grid_error(source, key, "expected a single value (number or word)");
+  return n.Scalar();
+}
+
+// One `name: value` map of settings, in file order.
+std::vector<std::pair<std::string, std::string>> settings_map(const YAML::Node& n,
+                                                              const std::string& source,
+                                                              const std::string& key) {
+  if (!n.IsMap()) grid_error(source, key, "expected a map of setting: value");
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& item : n) {
+    const std::string name = item.first.as<std::string>();
+    out.emplace_back(name, scalar_text(item.second, source, key + "." + name));
+  }
+  return out;
+}
+
+}  // namespace
+
+Grid grid_from_yaml(const std::string& text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": invalid YAML: " + e.what());
+  }
+  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a map with 'variants' and/or 'axes'");
+  Grid grid;
+  std::vector<Variant> base;
+  std::vector<std::pair<std::string, std::vector<std::string>>> axes;
+  for (const auto& item : root) {
+    const std::string key = item.first.as<std::string>();
+    const YAML::Node& n = item.second;
+    if (key == "name") {
+      grid.name = scalar_text(n, source, key);
+    } else if (key == "seeds") {
+      try {
+        grid.seeds = n.as<int>();
+      } catch (const YAML::Exception&) {
+        grid_error(source, key, "expected a positive integer, got '" + scalar_text(n, source, key) + "'");
+      }
+      if (grid.seeds < 1) grid_error(source, key, "expected a positive integer, got " + std::to_string(grid.seeds));
+    } else if (key == "variants") {
+      if (!n.IsSequence()) grid_error(source, key, "expected a list of {name, set}");
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        const std::string at = key + "[" + std::to_string(i) + "]";
+        if (!n[i].IsMap()) grid_error(source, at, "expected {name: ..., set: {...}}");
+        Variant v;
+        for (const auto& f : n[i]) {
+          const std::string fk = f.first.as<std::string>();
+          if (fk == "name") {
+            v.name = scalar_text(f.second, source, at + ".name");
+          } else if (fk == "set") {
+            v.settings = settings_map(f.second, source, at + ".set");
+          } else {
+            grid_error(source, at + "." + fk, "unknown key (expected name, set)");
+          }
+        }
+        if (v.name.empty()) grid_error(source, at + ".name", "missing");
+        base.push_back(v);
+      }
+    } else if (key == "axes") {
+      if (!n.IsMap()) grid_error(source, key, "expected a map of setting: [values]");
+      for (const auto& a : n) {
+        const std::string name = a.first.as<std::string>();
+        if (!a.second.IsSequence() || a.second.size() == 0) {
+          grid_error(source, key + "." + name, "expected a non-empty list of values");
+        }
+        std::vector<std::string> values;
+        for (std::size_t i = 0; i < a.second.size(); ++i) {
+          values.push_back(scalar_text(a.second[i], source, key + "." + name + "[" + std::to_string(i) + "]"));
+        }
+        axes.emplace_back(name, values);
+      }
+    } else {
+      grid_error(source, key, "unknown key (expected name, seeds, variants, axes)");
+    }
+  }
+  if (base.empty()) base.push_back(Variant{"", {}});
+  // Cartesian product of the axes, applied after each variant's own settings.
+  std::vector<Variant> expanded = base;
+  for (const auto& [name, values] : axes) {
+    std::vector<Variant> next;
+    for (const Variant& v : expanded) {
+      for (const std::string& value : values) {
+        Variant w = v;
+        w.settings.emplace_back(name, value);
+        w.name += (w.name.empty() ? "" : ",") + name + "=" + value;
+        next.push_back(w);
+      }
+    }
+    expanded = next;
+  }
+  std::set<std::string> names;
+  for (Variant& v : expanded) {
+    if (v.name.empty()) v.name = "default";
+    if (!names.insert(v.name).second) {
+      throw std::invalid_argument(source + ": variants: the name '" + v.name + "' is used twice");
+    }
+  }
+  grid.variants = expanded;
+  return grid;
+}
+
+Grid read_grid(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot read file");
+  std::stringstream s;
+  s << in.rdbuf();
+  return grid_from_yaml(s.str(), path);
+}
+
+}  // namespace ofv

@@ -1,0 +1,112 @@
+// A comparison sweep: planning, shards, and the parallel resumable run.
+#include "ofv/loop/sweep.h"
+
+#include "ofv/loop/episode_store.h"
+#include "ofv/loop/progress.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <cctype>
+#include <sstream>
+#include <stdexcept>
+
+namespace ofv {
+
+std::string safe_name(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    out += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '.') ? ch : '_';
+  }
+  return out;
+}
+
+std::string EpisodeSpec::id() const {
+  return safe_name(scenario) + "__" + safe_name(variant.name) + "__seed" + std::to_string(seed);
+}
+
+std::vector<EpisodeSpec> plan_episodes(
+    const std::vector<std::pair<std::string, std::string>>& scenarios, const Grid& grid) {
+  std::vector<EpisodeSpec> out;
+  for (const auto& [name, path] : scenarios) {
+    for (const Variant& v : grid.variants) {
+      for (int seed = 0; seed < grid.seeds; ++seed) {
+        EpisodeSpec s;
+        s.index = static_cast<int>(out.size());
+        s.scenario = name;
+        s.scenario_path = path;
+        s.variant = v;
+        s.seed = seed;
+        out.push_back(s);
+      }
+    }
+  }
+  return out;
+}
+
+Shard parse_shard(const std::string& text) {
+  Shard s;
+  char slash = 0;
+  std::istringstream in(text);
+  if (!(in >> s.k >> slash >> s.n) || slash != '/' || !in.eof()) {
+    throw std::invalid_argument("--shard " + text + ": expected K/N, e.g. 2/8");
+  }
+  return s;
+}
+
+std::vector<EpisodeSpec> shard(const std::vector<EpisodeSpec>& all, int k, int n) {
+  if (n < 1 || k < 1 || k > n) {
+    throw std::invalid_argument("--shard K/N needs 1 <= K <= N, got " + std::to_string(k) + "/" +
+                                std::to_string(n));
+  }
+  std::vector<EpisodeSpec> out;
+  for (const auto& s : all) {
+    if (s.index % n == k - 1) out.push_back(s);
+  }
+  return out;
+}
+
+int run_sweep(const std::vector<EpisodeSpec>& episodes, const EpisodeRunner& runner,
+              const std::string& out_dir, const SweepOptions& options) {
+  if (options.jobs < 0) {
+    throw std::invalid_argument("jobs must be >= 0 (0: one per core), got " +
+                                std::to_string(options.jobs));
+  }
+  const EpisodeStore store(out_dir);
+  std::vector<const EpisodeSpec*> todo;
+  for (const auto& s : episodes) {
+    if (!store.finished(s)) todo.push_back(&s);
+  }
+  ProgressBar progress(static_cast<double>(todo.size()), "episodes", options.progress);
+  tbb::task_arena arena(options.jobs > 0 ? options.jobs : tbb::task_arena::automatic);
+  arena.execute([&] {
+    // Grain 1 with the simple partitioner: one task per episode, so a thread
+    // that finishes a short episode takes the next one instead of waiting
+    // behind a chunk of long ones. With one job the episodes run in order.
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, todo.size(), 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const EpisodeSpec& spec = *todo[i];
+            try {
+              // Isolated: a thread waiting on TBB work inside the episode
+              // (Embree builds) must not start another episode meanwhile,
+              // whose run time would land in this episode's step times.
+              const EpisodeOutcome outcome =
+                  tbb::this_task_arena::isolate([&] { return runner(spec); });
+              store.write(spec, outcome);
+            } catch (const std::exception& e) {
+              // TBB skips the episodes not yet started and rethrows this in
+              // the caller; the episodes running finish and are kept.
+              throw std::runtime_error("episode " + spec.id() + ": " + e.what());
+            }
+            progress.tick();
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  return static_cast<int>(todo.size());
+}
+
+}  // namespace ofv
