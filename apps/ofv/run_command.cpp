@@ -124,6 +124,9 @@ Command add_run_command(CLI::App& app) {
               if (simulated) {
                 setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
                 setup.real_time = true;
+                if (setup.robot == RobotKind::Camera) {
+                  throw std::invalid_argument("--source sim: needs --robot viper850 or afma6 (ViSP's threaded simulators)");
+                }
               } else {
                 setup.duration = std::numeric_limits<double>::infinity();
                 episode_settings_table().apply(setup, settings);

@@ -16,7 +16,12 @@
 #define OFV_HAVE_THREADED_SIMULATORS
 #endif
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <iostream>
 #include <cmath>
 #include <stdexcept>
 
@@ -177,6 +182,34 @@ struct Placed : Simulator {
 };
 }  // namespace
 
+// ViSP's simulators print their set-up (arm files, camera parameters, the
+// control mode) on stdout, which `ofv run --dry-run` keeps for its JSON lines:
+// stdout goes to /dev/null while they are set up.
+class QuietStdout {
+ public:
+  QuietStdout() {
+    std::cout.flush();
+    std::fflush(stdout);
+    saved_ = ::dup(STDOUT_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDOUT_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStdout() {
+    std::cout.flush();
+    std::fflush(stdout);
+    if (saved_ >= 0) {
+      ::dup2(saved_, STDOUT_FILENO);
+      ::close(saved_);
+    }
+  }
+  QuietStdout(const QuietStdout&) = delete;
+  QuietStdout& operator=(const QuietStdout&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
 struct ThreadedArm::Impl {
   std::unique_ptr<vpRobot> simulator;
   std::unique_ptr<VispRobot> robot;
@@ -186,9 +219,11 @@ struct ThreadedArm::Impl {
 ThreadedArm::ThreadedArm(KinematicArm::Model model, const vpHomogeneousMatrix& wMc_start)
     : impl_(std::make_unique<Impl>()) {
   // The simulator, headless, started in KinematicArm's start configuration.
+  const QuietStdout quiet;
   const vpColVector q0 = KinematicArm::start_joints(model);
   auto make = [&](auto simulator, const char* name) {
     simulator->place(q0);
+    simulator->setRobotState(vpRobot::STATE_VELOCITY_CONTROL);
     simulator->setMaxTranslationVelocity(2.0);  // [m/s]; the controller's limits bind first
     simulator->setMaxRotationVelocity(4.0);     // [rad/s]
     vpPoseVector p;

@@ -29,6 +29,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
   try {
     std::optional<double> first_stamp, last_stamp;
     while (options.stop == nullptr || *options.stop == 0) {
+      const auto asked = Clock::now();
       std::optional<RgbdFrame> frame = source.next();
       if (!frame) break;
       const auto arrived = Clock::now();
@@ -43,6 +44,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       out.index = summary.frames;
       out.frame = &*frame;
       out.dt = dt;
+      out.source_s = std::chrono::duration<double>(arrived - asked).count();
       std::optional<ViewProblem> problem;
       PerceptionResult result;
       if (options.problem_source) {

@@ -183,6 +183,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;
     (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
+    rec.times.render = f.source_s;
     rec.times.perception = f.perception_s;
     record_step(rec, *f.step);
     outcome.steps.push_back(rec);

@@ -52,6 +52,7 @@ struct RobotLoopFrame {
   const LoopStep* step = nullptr;
   double dt = 0.0;         ///< period the command is applied for [s]
   double frame_age = 0.0;  ///< [s]
+  double source_s = 0.0;      ///< time spent waiting for and reading the frame [s]
   double perception_s = 0.0;  ///< compute time of perception [s]
 };
 

@@ -1,0 +1,128 @@
+// One loop for simulation and robots, end to end through the CLI: `ofv run`
+// replays a simulated episode's commands from its recording, and rehearses a
+// deployment on ViSP's threaded simulator with a live simulated sensor.
+#include "cli_run.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+namespace ofv {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Command {
+  std::string status;
+  std::vector<double> v;
+};
+
+// trajectory.csv: status and velocity columns by name.
+std::vector<Command> episode_commands(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream h(line);
+  for (std::string c; std::getline(h, c, ',');) header.push_back(c);
+  std::vector<Command> out;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream r(line);
+    for (std::string c; std::getline(r, c, ',');) cells.push_back(c);
+    Command c;
+    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) {
+      if (header[i] == "status") c.status = cells[i];
+      for (const char* name : {"vx", "vy", "vz", "wx", "wy", "wz"}) {
+        if (header[i] == name) c.v.push_back(std::stod(cells[i]));
+      }
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+// `ofv run --dry-run` JSON lines.
+std::vector<Command> dry_run_commands(const std::string& out) {
+  std::vector<Command> commands;
+  std::stringstream in(out);
+  for (std::string line; std::getline(in, line);) {
+    const auto j = nlohmann::json::parse(line);
+    commands.push_back({j.at("status").get<std::string>(), j.at("v").get<std::vector<double>>()});
+  }
+  return commands;
+}
+
+double largest_difference(const std::vector<Command>& a, const std::vector<Command>& b) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
+    for (std::size_t i = 0; i < 6; ++i) worst = std::max(worst, std::abs(a[k].v.at(i) - b[k].v.at(i)));
+  }
+  return worst;
+}
+
+TEST(OneLoop, RunReplaysTheCommandsOfASimulatedEpisode) {
+  const fs::path dir = fs::path(test::scratch_dir()) / "one_loop";
+  const std::string settings = " --set gain=5 --set target_hysteresis=false";
+  const CommandRun sim = run("simulate dvd-one-hand --set duration=1.5 --no-pictures" + settings + " --out " +
+                             (dir / "episode").string() + " --record " + (dir / "frames").string());
+  ASSERT_EQ(sim.code, 0) << sim.err;
+  const std::vector<Command> episode = episode_commands(dir / "episode" / "trajectory.csv");
+  ASSERT_EQ(episode.size(), 46U);
+
+  const CommandRun replay = run("run --robot camera --source " + (dir / "frames").string() + " --dry-run" + settings);
+  ASSERT_EQ(replay.code, 0) << replay.err;
+  std::vector<Command> commands = dry_run_commands(replay.out);
+  ASSERT_EQ(commands.size(), episode.size() + 1);
+  EXPECT_EQ(commands.back().status, "stop");  // the final command leaves the robot at rest
+  EXPECT_EQ(largest_difference({commands.back()}, {Command{"", std::vector<double>(6, 0.0)}}), 0.0);
+  commands.pop_back();
+  for (std::size_t k = 0; k < episode.size(); ++k) EXPECT_EQ(commands[k].status, episode[k].status) << "frame " << k;
+  EXPECT_LE(largest_difference(commands, episode), 1e-9);
+
+  // Other settings, other commands: the comparison can fail.
+  const CommandRun other = run("run --robot camera --source " + (dir / "frames").string() + " --dry-run --set gain=3");
+  ASSERT_EQ(other.code, 0) << other.err;
+  EXPECT_GT(largest_difference(dry_run_commands(other.out), episode), 1e-3);
+}
+
+TEST(OneLoop, RehearsalRunsInWallClockTimeOnTheThreadedArm) {
+  const auto start = std::chrono::steady_clock::now();
+  const CommandRun r = run("run --robot viper850 --source sim:dvd-one-hand --set duration=1.5");
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GE(elapsed, 1.5);
+  EXPECT_NE(r.out.find("rehearsal of dvd-one-hand on the threaded viper850"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("visible fraction: mean"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("distance to the sphere"), std::string::npos) << r.out;
+  EXPECT_EQ(run("run --robot camera --source sim:dvd-one-hand").code, 2);  // no threaded free-flying camera
+  EXPECT_EQ(run("run --robot viper850 --source sim:no-such-scenario").code, 2);
+}
+
+TEST(OneLoop, SignalsStopTheRobotAndEndTheRun) {
+  for (const char* signal : {"INT", "TERM"}) {
+    // Like Ctrl-C (INT) or a kill (TERM) 1.5 s into a 30 s run.
+    CommandRun r;
+    const std::string command = std::string("timeout --preserve-status -s ") + signal + " 1.5 " + OFV_BINARY +
+                                " run --robot afma6 --source sim:dvd-one-hand --set duration=30 --dry-run 2>/dev/null";
+    FILE* pipe = popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    char buffer[4096];
+    for (std::size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.out.append(buffer, n);
+    const int status = pclose(pipe);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    EXPECT_EQ(r.code, 0) << signal << ": " << r.err;
+    const std::vector<Command> commands = dry_run_commands(r.out.substr(0, r.out.find("ofv run:")));
+    ASSERT_FALSE(commands.empty()) << signal;
+    EXPECT_EQ(commands.back().status, "stop") << signal;
+    EXPECT_NE(r.out.find(", stopped"), std::string::npos) << signal << ": " << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace ofv
