@@ -43,7 +43,10 @@ int main(int argc, char** argv) {
         {"push_radius=r_seed", {{"push_radius", "r_seed"}}},  // the paper's other reading
         {"t0_only", {{"method", "initial_view"}}},            // occlusion-blind baseline
     };
-    for (auto& v : grid.variants) v.settings.emplace_back("duration", duration);
+    for (auto& v : grid.variants) {
+      v.settings.emplace_back("duration", duration);
+      v.settings.emplace_back("perception", "ground-truth");  // the simulator's supervoxels: only the method differs
+    }
 
     // 2. The scenarios: built-in ones by name, or your own YAML files.
     std::vector<std::pair<std::string, std::string>> scenarios;

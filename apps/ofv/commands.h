@@ -24,7 +24,10 @@ struct Command {
 };
 
 /// The estimator settings, their defaults and units, for every command's help.
-const char* estimator_settings_help();
+std::string estimator_settings_help();
+
+/// Registers `ofv settings` (every setting: name, type, default, unit, meaning) on the app.
+Command add_settings_command(CLI::App& app);
 
 /// Applies `--set name=value` assignments in order.
 /// \throws std::invalid_argument naming the assignment when it is malformed or invalid.

@@ -2,6 +2,7 @@
 #include "commands.h"
 
 #include "ofv/estimator.h"
+#include "ofv/estimator_settings.h"
 #include "ofv/io/scene_json.h"
 
 #include <nlohmann/json.hpp>
@@ -29,23 +30,9 @@ constexpr const char* kSceneHelp = R"(Scene file (metres, world frame):
 
 }  // namespace
 
-const char* estimator_settings_help() {
-  return R"(Estimator settings (in "params" or with --set name=value; explicit values override the preset):
-  preset          paper | authors_code              default paper
-                  authors_code: step = r_seed/2, clearance = 2 r_seed, max_iterations = 50
-  r_seed          supervoxel seed resolution [m]    default 0.02
-  r_sphere        radius of the solution sphere [m] default 0.5
-  initial_view    spherical_mean | vector_mean      default spherical_mean
-                  how t0 averages the normals-to-sphere rays
-  clearance       t_i is clear when no projected occlusion point lies closer [m]
-                                                    default r_seed
-  push_radius     projected points closer than this push the view [m]
-                                                    default r_sphere (paper); r_seed is the other reading
-  push_weighting  sum | inverse_distance            default sum
-  step            length of one push on the tangent plane [m]  default r_seed
-  max_iterations  push steps before giving up (integer >= 0)   default 500
-  warm_start      true | false: start from previous_view instead of t0  default false
-)";
+std::string estimator_settings_help() {
+  return "Estimator settings (in \"params\" or with --set name=value; explicit values override the preset):\n" +
+         settings_help(estimator_settings_table().docs());
 }
 
 namespace {

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   commands.push_back(add_compare_command(app));
 #endif
   commands.push_back(add_estimate_command(app));
+  commands.push_back(add_settings_command(app));
 #ifdef OFV_HAVE_PERCEPTION  // built with the perception front end (OFV_BUILD_PERCEPTION)
   commands.push_back(add_perceive_command(app));
 #endif

@@ -4,14 +4,12 @@
 
 #include "ofv/loop/episode.h"
 #include "ofv/loop/episode_files.h"
+#include "ofv/loop/progress.h"
 
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
-#include <unistd.h>
 
 namespace ofv::cli {
 
@@ -85,18 +83,10 @@ Command add_simulate_command(CLI::App& app) {
               files.video = opt->video;
               files.record_dir = opt->record;
               EpisodeWriter writer(dir.string(), setup, files);
-              const bool tty = isatty(2) != 0;
-              const long total = static_cast<long>(std::floor(setup.duration * setup.scenario.rate + 1e-9)) + 1;
-              long index = 0;
+              ProgressBar progress(setup.duration, "s of the episode");
               const EpisodeOutcome outcome = run_episode(setup, [&](const StepRecord& rec, const StepDetail& d) {
                 writer.observe(rec, d);
-                ++index;
-                if (tty) {
-                  const int filled = static_cast<int>(30 * index / total);
-                  std::fprintf(stderr, "\r[%s%s] %.2f s / %.2f s  visible %.2f ", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                               std::string(static_cast<std::size_t>(30 - filled), '.').c_str(), rec.time, setup.duration, rec.visible_fraction);
-                  if (index == total) std::fprintf(stderr, "\n");
-                }
+                progress.set(rec.time);
               });
               const std::vector<std::string> written = writer.finish(outcome);
               std::cout << "ofv simulate: " << setup.scenario.name << ", robot " << to_string(setup.robot) << ", "

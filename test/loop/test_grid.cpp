@@ -30,6 +30,20 @@ axes:
   EXPECT_EQ(g.variants[7].settings[3].second, "sampling");
 }
 
+TEST(Grid, CommonSettingsComeFirstInEveryVariant) {
+  const Grid g = grid_from_yaml(R"(
+set: {perception: ground-truth, gain: 3}
+variants:
+  - name: a
+    set: {gain: 5}
+  - name: b
+)", "grid.yaml");
+  ASSERT_EQ(g.variants.size(), 2U);
+  using S = std::vector<std::pair<std::string, std::string>>;
+  EXPECT_EQ(g.variants[0].settings, (S{{"perception", "ground-truth"}, {"gain", "3"}, {"gain", "5"}}));
+  EXPECT_EQ(g.variants[1].settings, (S{{"perception", "ground-truth"}, {"gain", "3"}}));
+}
+
 TEST(Grid, ErrorsNameFileAndKey) {
   const std::vector<std::pair<std::string, std::string>> cases{
       {"seeds: -1", "seeds"},

@@ -47,6 +47,7 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
   if (!root.IsMap()) throw std::invalid_argument(source + ": expected a map with 'variants' and/or 'axes'");
   Grid grid;
   std::vector<Variant> base;
+  std::vector<std::pair<std::string, std::string>> common;
   std::vector<std::pair<std::string, std::vector<std::string>>> axes;
   for (const auto& item : root) {
     const std::string key = item.first.as<std::string>();
@@ -60,6 +61,8 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
         grid_error(source, key, "expected a positive integer, got '" + scalar_text(n, source, key) + "'");
       }
       if (grid.seeds < 1) grid_error(source, key, "expected a positive integer, got " + std::to_string(grid.seeds));
+    } else if (key == "set") {
+      common = settings_map(n, source, key);
     } else if (key == "variants") {
       if (!n.IsSequence()) grid_error(source, key, "expected a list of {name, set}");
       for (std::size_t i = 0; i < n.size(); ++i) {
@@ -93,10 +96,12 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
         axes.emplace_back(name, values);
       }
     } else {
-      grid_error(source, key, "unknown key (expected name, seeds, variants, axes)");
+      grid_error(source, key, "unknown key (expected name, seeds, set, variants, axes)");
     }
   }
   if (base.empty()) base.push_back(Variant{"", {}});
+  // The grid's own settings come first: a variant's may override them.
+  for (Variant& v : base) v.settings.insert(v.settings.begin(), common.begin(), common.end());
   // Cartesian product of the axes, applied after each variant's own settings.
   std::vector<Variant> expanded = base;
   for (const auto& [name, values] : axes) {
