@@ -1,11 +1,11 @@
 // `ofv perceive SOURCE [--out DIR] [--pictures]`: the perception front end
 // and the estimator on every frame of a recording or device.
 #include "commands.h"
-#include "perception_picture.h"
 
 #include "ofv/estimator.h"
 #include "ofv/io/scene_json.h"
 #include "ofv/perception/perception.h"
+#include "ofv/perception/picture.h"
 #include "ofv/sources/open_source.h"
 
 #include <nlohmann/json.hpp>
