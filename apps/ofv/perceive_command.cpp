@@ -113,14 +113,14 @@ PerceptionSettings perception_settings(const Options& opt, const EstimatorSettin
   if (!opt.box.empty()) {
     const auto b = parse_numbers(opt.box, 6, "--box");
     ps.selection.mode = ObjectSelection::Mode::Box;
-    ps.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]),
-                                           Eigen::Vector3d(b[3], b[4], b[5]));
+    ps.selection.box =
+        Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5]));
   } else if (!opt.rect.empty()) {
     const auto b = parse_numbers(opt.rect, 4, "--rect");
     ps.selection.mode = ObjectSelection::Mode::Image;
-    ps.selection.rect = Eigen::AlignedBox2i(
-        Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
-        Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
+    ps.selection.rect =
+        Eigen::AlignedBox2i(Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
+                            Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
   }
   validate(ps);
   return ps;

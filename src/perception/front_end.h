@@ -27,7 +27,9 @@ namespace ofv {
 namespace detail {
 
 /// Colour without brightness: R, G, B over their sum (shading-invariant).
-inline Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) { return rgb / std::max(rgb.sum(), 1.0f); }
+inline Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) {
+  return rgb / std::max(rgb.sum(), 1.0f);
+}
 
 /// Pixel of world point p in the frame's camera; nullopt behind the camera.
 inline std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eigen::Isometry3d& cMw,
@@ -55,7 +57,8 @@ inline bool hidden(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const E
   const CameraIntrinsics& k = frame.intrinsics;
   if (u < 0 || v < 0 || u >= k.width || v >= k.height) return true;
   const float observed = frame.depth[frame.index(u, v)];
-  return std::isfinite(observed) && observed > 0.0f && static_cast<double>(observed) < z - tolerance;
+  return std::isfinite(observed) && observed > 0.0f &&
+         static_cast<double>(observed) < z - tolerance;
 }
 
 }  // namespace detail
@@ -94,9 +97,9 @@ struct Perception::Impl {
     Eigen::Vector3d centroid, normal;
     int age = 0;  // frames since it was last seen
   };
-  std::vector<Vertex> vertex_memory;  // object supervoxels: seen now, or hidden behind something
-  std::size_t initial_voxels = 0;              // object voxels in the first frame (seen whole)
-  std::optional<Eigen::Vector4d> plane;        // dominant (support) plane found in the first frame
+  std::vector<Vertex> vertex_memory;     // object supervoxels: seen now, or hidden behind something
+  std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
+  std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
 
   /// True for a voxel of the support plane: on it, and of its colour.

@@ -21,8 +21,9 @@ constexpr int kWidth = 800;
 constexpr int kHeight = 600;
 
 /// An OpenCV colour (B, G, R) from R, G, B.
-cv::Scalar rgb(int r, int g, int b) { return {static_cast<double>(b), static_cast<double>(g),
-                                               static_cast<double>(r)}; }
+cv::Scalar rgb(int r, int g, int b) {
+  return {static_cast<double>(b), static_cast<double>(g), static_cast<double>(r)};
+}
 
 const cv::Scalar kWhite = rgb(255, 255, 255);
 const cv::Scalar kCyan = rgb(0, 255, 255);
@@ -87,8 +88,8 @@ void dot(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv
   }
 }
 
-void square(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p,
-            const cv::Scalar& colour, double half) {
+void square(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+            double half) {
   if (const auto ip = obs(p)) {
     const auto side = static_cast<int>(2 * half);
     cv::rectangle(image, cv::Rect(pixel(*ip - cv::Point2d(half, half)), cv::Size(side, side)),
@@ -107,8 +108,8 @@ void text(cv::Mat& image, const std::string& s, const cv::Point2d& at, const cv:
   }
 }
 
-void marker(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p,
-            const cv::Scalar& colour, const std::string& label) {
+void marker(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+            const std::string& label) {
   if (const auto ip = obs(p)) {
     cv::circle(image, pixel(*ip), 7, colour, 2);
     text(image, label, *ip + cv::Point2d(8, -22), colour);

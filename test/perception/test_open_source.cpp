@@ -78,20 +78,23 @@ TEST(OpenSource, OniFileOpensARecording) {
 
 TEST(OpenSource, OpenNi2UriOpensTheDeviceItNames) {
   // No such device: OpenNI2's own error, naming the URI after the scheme.
-  EXPECT_NE(error_of<std::runtime_error>([] { open_source("openni2://no-such-device", 1.0f); })
-                .find("no-such-device"),
+  EXPECT_NE(error_of<std::runtime_error>([] {
+              open_source("openni2://no-such-device", 1.0f);
+            }).find("no-such-device"),
             std::string::npos);
 }
 
 TEST(OpenSource, OtherNamesAreErrorsNamingTheSource) {
   const std::string missing_oni = scratch("missing.oni").string();
-  EXPECT_NE(error_of<std::invalid_argument>([&] { open_source(missing_oni, -1.0f); })
-                .find(missing_oni + ": no such .oni file"),
+  EXPECT_NE(error_of<std::invalid_argument>([&] {
+              open_source(missing_oni, -1.0f);
+            }).find(missing_oni + ": no such .oni file"),
             std::string::npos);
   const fs::path empty = scratch("empty");
   fs::create_directories(empty);
-  EXPECT_NE(error_of<std::invalid_argument>([&] { open_source(empty.string(), -1.0f); })
-                .find(empty.string() + ": not a TUM RGB-D directory"),
+  EXPECT_NE(error_of<std::invalid_argument>([&] {
+              open_source(empty.string(), -1.0f);
+            }).find(empty.string() + ": not a TUM RGB-D directory"),
             std::string::npos);
   const std::string nothing = scratch("nothing").string();
   EXPECT_NE(error_of<std::invalid_argument>([&] { open_source(nothing, -1.0f); }).find(nothing),

@@ -22,7 +22,7 @@ namespace ofv {
  *   first device found.
  *
  * \code
- * const std::unique_ptr<ofv::FrameSource> source = ofv::open_source("rgbd_dataset_freiburg1_xyz", -1.0f);
+ * const auto source = ofv::open_source("rgbd_dataset_freiburg1_xyz", -1.0f);
  * while (const auto frame = source->next()) { ... }
  * \endcode
  *
