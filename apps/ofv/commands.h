@@ -3,7 +3,8 @@
 
 #include "ofv/estimator.h"
 
-#include "ofv/frame_source.h"
+// Only until run_command.cpp includes it itself: it calls ofv::open_source.
+#include "ofv/sources/open_source.h"
 
 #include <CLI/CLI.hpp>
 
@@ -44,11 +45,6 @@ Command add_simulate_command(CLI::App& app);
 
 /// Registers `ofv compare` (settings compared in closed loop) on the app.
 Command add_compare_command(CLI::App& app);
-
-/// Opens a frame source: a TUM RGB-D folder, a PCD sequence, a .oni file or
-/// openni2://URI; `speed` is the .oni playback speed. Throws
-/// std::invalid_argument naming the source when it is none of these.
-std::unique_ptr<FrameSource> open_source(const std::string& source, float speed);
 
 /// Registers `ofv run` (the closed loop on a robot and a sensor) on the app.
 Command add_run_command(CLI::App& app);

@@ -1,14 +1,13 @@
 // `ofv perceive SOURCE [--out DIR] [--pictures]`: the perception front end
 // and the estimator on every frame of a recording or device.
 #include "commands.h"
-#include "perception_picture.h"
 
 #include "ofv/estimator.h"
 #include "ofv/io/scene_json.h"
 #include "ofv/perception/perception.h"
+#include "ofv/perception/picture.h"
+#include "ofv/sources/open_source.h"
 #include "ofv/sources/openni2_source.h"
-#include "ofv/sources/pcd_sequence.h"
-#include "ofv/sources/tum_sequence.h"
 
 #include <nlohmann/json.hpp>
 
@@ -85,52 +84,88 @@ nlohmann::ordered_json timings_json(const PerceptionTimings& t, double estimate_
           {"estimate", estimate_ms}};
 }
 
-}  // namespace
+/// What the user asked for, as parsed.
+struct Options {
+  std::string source;
+  std::string out;
+  bool pictures = false;
+  std::vector<std::string> sets;
+  std::string box;
+  std::string rect;
+  int max_frames = -1;
+  float speed = OpenNi2Options{}.playback_speed;
+  double voxel = SupervoxelSettings{}.voxel_resolution;
+  double obb_margin = PerceptionSettings{}.obb_margin;
+  double max_motion = TrackingSettings{}.max_motion;
+  bool no_plane_occluders = false;
+};
 
-std::unique_ptr<FrameSource> open_source(const std::string& source, float speed) {
-  OpenNi2Options oni;
-  oni.playback_speed = speed;
-  const std::string scheme = "openni2://";
-  if (source.rfind(scheme, 0) == 0) {
-    const std::string uri = source.substr(scheme.size());
-    return std::make_unique<OpenNi2Source>(uri, oni);  // empty: the first device
+/// The front end's settings: the options, and the estimator's R_seed and R_sphere.
+/// \throws std::invalid_argument naming the option or setting that is invalid.
+PerceptionSettings perception_settings(const Options& opt, const EstimatorSettings& settings) {
+  PerceptionSettings ps;
+  ps.supervoxels.seed_resolution = settings.r_seed;
+  ps.supervoxels.voxel_resolution = opt.voxel;
+  ps.r_sphere = settings.r_sphere;
+  ps.obb_margin = opt.obb_margin;
+  ps.tracking.max_motion = opt.max_motion;
+  ps.support_plane_occludes = !opt.no_plane_occluders;
+  if (!opt.box.empty()) {
+    const auto b = parse_numbers(opt.box, 6, "--box");
+    ps.selection.mode = ObjectSelection::Mode::Box;
+    ps.selection.box =
+        Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5]));
+  } else if (!opt.rect.empty()) {
+    const auto b = parse_numbers(opt.rect, 4, "--rect");
+    ps.selection.mode = ObjectSelection::Mode::Image;
+    ps.selection.rect =
+        Eigen::AlignedBox2i(Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
+                            Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
   }
-  if (source.size() > 4 && source.compare(source.size() - 4, 4, ".oni") == 0) {
-    if (!fs::is_regular_file(source)) {
-      throw std::invalid_argument(source + ": no such .oni file");
-    }
-    return std::make_unique<OpenNi2Source>(source, oni);
-  }
-  if (fs::is_directory(source)) {
-    if (fs::exists(fs::path(source) / "depth.txt")) {
-      return std::make_unique<TumSequenceSource>(source);
-    }
-    for (const auto& entry : fs::directory_iterator(source)) {
-      if (entry.path().extension() == ".pcd") {
-        return std::make_unique<PcdSequenceSource>(source);
-      }
-    }
-  }
-  throw std::invalid_argument(source +
-                              ": not a TUM RGB-D directory, a PCD sequence, a .oni file or an "
-                              "openni2:// URI");
+  validate(ps);
+  return ps;
 }
 
+/// One frame's record: {"frame", "timestamp", "status", ["message",] "problem",
+/// "estimate", "counts", "timings_ms"}; problem and estimate are null when lost.
+nlohmann::ordered_json frame_json(int index, const RgbdFrame& frame, const PerceptionResult& r,
+                                  const std::optional<Scene>& scene,
+                                  const std::optional<ViewEstimate>& estimate, double estimate_ms) {
+  nlohmann::ordered_json j;
+  j["frame"] = index;
+  j["timestamp"] = frame.timestamp;
+  j["status"] = to_string(r.status);
+  if (!r.message.empty()) {
+    j["message"] = r.message;
+  }
+  j["problem"] = scene ? scene_to_json(*scene) : nlohmann::ordered_json(nullptr);
+  j["estimate"] = estimate ? estimate_to_json(*estimate) : nlohmann::ordered_json(nullptr);
+  j["counts"] = counts_json(r.counts);
+  j["timings_ms"] = timings_json(r.timings, estimate_ms);
+  return j;
+}
+
+/// DIR/frame_NNNNNN.json and, with `picture`, DIR/frame_NNNNNN.png.
+/// \throws std::runtime_error naming the file that cannot be written.
+void write_frame(const std::string& dir, int index, const nlohmann::ordered_json& j, bool picture,
+                 const RgbdFrame& frame, const PerceptionResult& r,
+                 const std::optional<ViewEstimate>& estimate, double r_sphere) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d", index);
+  const fs::path base = fs::path(dir) / name;
+  std::ofstream file(base.string() + ".json");
+  file << j.dump(2) << '\n';
+  if (!file) {
+    throw std::runtime_error(base.string() + ".json: cannot write");
+  }
+  if (picture) {
+    save_perception_picture(base.string() + ".png", frame, r, estimate, r_sphere);
+  }
+}
+
+}  // namespace
+
 Command add_perceive_command(CLI::App& app) {
-  struct Options {
-    std::string source;
-    std::string out;
-    bool pictures = false;
-    std::vector<std::string> sets;
-    std::string box;
-    std::string rect;
-    int max_frames = -1;
-    float speed = -1.0f;
-    double voxel = 0.008;
-    double obb_margin = 0.03;
-    double max_motion = 0.012;
-    bool no_plane_occluders = false;
-  };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
       "perceive", "Run the perception front end and the estimator on every frame of a source");
@@ -148,12 +183,13 @@ Command add_perceive_command(CLI::App& app) {
       ->type_name("U0,V0,U1,V1");
   sub->add_option("--max-frames", opt->max_frames, "Stop after this many frames");
   sub->add_option("--speed", opt->speed,
-                  "Playback speed of .oni files: 1 real time, 0 fastest, -1 every frame (default)");
-  sub->add_option("--voxel", opt->voxel, "Voxel resolution [m] (default 0.008)");
-  sub->add_option("--obb-margin", opt->obb_margin,
-                  "Augmentation of the object's OBB [m] (default 0.03)");
-  sub->add_option("--max-motion", opt->max_motion,
-                  "Largest object motion between frames [m] (default 0.012)");
+                  "Playback speed of .oni files: 1 real time, 0 fastest, -1 every frame")
+      ->capture_default_str();
+  sub->add_option("--voxel", opt->voxel, "Voxel resolution [m]")->capture_default_str();
+  sub->add_option("--obb-margin", opt->obb_margin, "Augmentation of the object's OBB [m]")
+      ->capture_default_str();
+  sub->add_option("--max-motion", opt->max_motion, "Largest object motion between frames [m]")
+      ->capture_default_str();
   sub->add_flag("--no-plane-occluders", opt->no_plane_occluders,
                 "The support plane (found in frame 0) is background, not occluders");
   sub->footer(kSourceHelp);
@@ -169,25 +205,7 @@ Command add_perceive_command(CLI::App& app) {
               }
               apply_sets(params, opt->sets);
               settings = params.resolve();
-              ps.supervoxels.seed_resolution = settings.r_seed;
-              ps.supervoxels.voxel_resolution = opt->voxel;
-              ps.r_sphere = settings.r_sphere;
-              ps.obb_margin = opt->obb_margin;
-              ps.tracking.max_motion = opt->max_motion;
-              ps.support_plane_occludes = !opt->no_plane_occluders;
-              if (!opt->box.empty()) {
-                const auto b = parse_numbers(opt->box, 6, "--box");
-                ps.selection.mode = ObjectSelection::Mode::Box;
-                ps.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]),
-                                                       Eigen::Vector3d(b[3], b[4], b[5]));
-              } else if (!opt->rect.empty()) {
-                const auto b = parse_numbers(opt->rect, 4, "--rect");
-                ps.selection.mode = ObjectSelection::Mode::Image;
-                ps.selection.rect = Eigen::AlignedBox2i(
-                    Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
-                    Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
-              }
-              validate(ps);
+              ps = perception_settings(*opt, settings);
               source = open_source(opt->source, opt->speed);
               if (!opt->out.empty()) {
                 std::error_code ec;
@@ -218,48 +236,28 @@ Command add_perceive_command(CLI::App& app) {
                 }
                 const PerceptionResult r = perception.process(*frame);
                 front_end_ms.push_back(r.timings.total);
-                nlohmann::ordered_json j;
-                j["frame"] = frames;
-                j["timestamp"] = frame->timestamp;
-                j["status"] = to_string(r.status);
-                if (!r.message.empty()) {
-                  j["message"] = r.message;
-                }
+                std::optional<Scene> scene;
                 std::optional<ViewEstimate> estimate;
                 double estimate_ms = 0.0;
                 if (r.status != TrackingStatus::Lost) {
-                  Scene scene{r.problem, params};
-                  scene.problem.previous_view = previous_view;
+                  scene = Scene{r.problem, params};
+                  scene->problem.previous_view = previous_view;
                   const auto start = std::chrono::steady_clock::now();
-                  estimate = estimate_view(scene.problem, settings);
+                  estimate = estimate_view(scene->problem, settings);
                   estimate_ms = std::chrono::duration<double, std::milli>(
                                     std::chrono::steady_clock::now() - start)
                                     .count();
                   previous_view = estimate->tf;
-                  j["problem"] = scene_to_json(scene);
-                  j["estimate"] = estimate_to_json(*estimate);
                 } else {
                   ++lost;
-                  j["problem"] = nullptr;
-                  j["estimate"] = nullptr;
                 }
-                j["counts"] = counts_json(r.counts);
-                j["timings_ms"] = timings_json(r.timings, estimate_ms);
+                const nlohmann::ordered_json j =
+                    frame_json(frames, *frame, r, scene, estimate, estimate_ms);
                 if (opt->out.empty()) {
                   std::cout << j.dump() << '\n';
                 } else {
-                  char name[32];
-                  std::snprintf(name, sizeof name, "frame_%06d", frames);
-                  const fs::path base = fs::path(opt->out) / name;
-                  std::ofstream file(base.string() + ".json");
-                  file << j.dump(2) << '\n';
-                  if (!file) {
-                    throw std::runtime_error(base.string() + ".json: cannot write");
-                  }
-                  if (opt->pictures) {
-                    save_perception_picture(base.string() + ".png", *frame, r, estimate,
-                                            settings.r_sphere);
-                  }
+                  write_frame(opt->out, frames, j, opt->pictures, *frame, r, estimate,
+                              settings.r_sphere);
                 }
                 ++frames;
               }

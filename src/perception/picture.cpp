@@ -1,26 +1,33 @@
-// Fig. 6-like pictures drawn with ViSP's vpImageDraw into a vpImage<vpRGBa>.
-#include "perception_picture.h"
+// Fig. 6-like pictures drawn with OpenCV into an 8-bit BGR image.
+#include "ofv/perception/picture.h"
 
-#include <visp3/core/vpColor.h>
-#include <visp3/core/vpFont.h>
-#include <visp3/core/vpImage.h>
-#include <visp3/core/vpImageDraw.h>
-#include <visp3/core/vpImagePoint.h>
-#include <visp3/io/vpImageIo.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
-namespace ofv::cli {
+namespace ofv {
 
 namespace {
 
 constexpr int kWidth = 800;
 constexpr int kHeight = 600;
+
+/// An OpenCV colour (B, G, R) from R, G, B.
+cv::Scalar rgb(int r, int g, int b) {
+  return {static_cast<double>(b), static_cast<double>(g), static_cast<double>(r)};
+}
+
+const cv::Scalar kWhite = rgb(255, 255, 255);
+const cv::Scalar kCyan = rgb(0, 255, 255);
+const cv::Scalar kMagenta = rgb(255, 60, 255);
 
 /// A pinhole observer looking at `target` from `eye`, `up` roughly up in the image.
 class Observer {
@@ -40,14 +47,14 @@ class Observer {
     cRw_.row(2) = z.transpose();
     eye_ = eye;
   }
-  /// Image point of world point p, or nothing behind the observer.
-  [[nodiscard]] std::optional<vpImagePoint> operator()(const Eigen::Vector3d& p) const {
+  /// Pixel (u right, v down) of world point p, or nothing behind the observer.
+  [[nodiscard]] std::optional<cv::Point2d> operator()(const Eigen::Vector3d& p) const {
     const Eigen::Vector3d c = cRw_ * (p - eye_);
     if (c.z() < 1e-3) {
       return std::nullopt;
     }
-    return vpImagePoint(focal_ * c.y() / c.z() + kHeight / 2.0,
-                        focal_ * c.x() / c.z() + kWidth / 2.0);
+    return cv::Point2d(focal_ * c.x() / c.z() + kWidth / 2.0,
+                       focal_ * c.y() / c.z() + kHeight / 2.0);
   }
 
  private:
@@ -56,44 +63,56 @@ class Observer {
   double focal_;
 };
 
-void line(vpImage<vpRGBa>& image, const Observer& obs, const Eigen::Vector3d& a,
-          const Eigen::Vector3d& b, const vpColor& colour, unsigned thickness = 1) {
+cv::Point pixel(const cv::Point2d& p) {
+  return {static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y))};
+}
+
+/// A filled `size` x `size` square with its top-left corner at p.
+void point(cv::Mat& image, const cv::Point2d& p, const cv::Scalar& colour, int size) {
+  cv::rectangle(image, cv::Rect(pixel(p), cv::Size(size, size)), colour, cv::FILLED);
+}
+
+void line(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+          const cv::Scalar& colour, int thickness = 1) {
   const auto pa = obs(a);
   const auto pb = obs(b);
   if (pa && pb) {
-    vpImageDraw::drawLine(image, *pa, *pb, colour, thickness);
+    cv::line(image, pixel(*pa), pixel(*pb), colour, thickness);
   }
 }
 
-void dot(vpImage<vpRGBa>& image, const Observer& obs, const Eigen::Vector3d& p,
-         const vpColor& colour, unsigned thickness = 1) {
-  if (const auto ip = obs(p);
-      ip && ip->get_i() >= 0 && ip->get_j() >= 0 && ip->get_i() < kHeight && ip->get_j() < kWidth) {
-    vpImageDraw::drawPoint(image, *ip, colour, thickness);
+void dot(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+         int size) {
+  if (const auto ip = obs(p); ip && ip->x >= 0 && ip->y >= 0 && ip->x < kWidth && ip->y < kHeight) {
+    point(image, *ip, colour, size);
   }
 }
 
-void square(vpImage<vpRGBa>& image, const Observer& obs, const Eigen::Vector3d& p,
-            const vpColor& colour, double half = 3.0) {
+void square(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+            double half) {
   if (const auto ip = obs(p)) {
-    vpImageDraw::drawRectangle(
-        image, vpRect(ip->get_j() - half, ip->get_i() - half, 2 * half, 2 * half), colour);
+    const auto side = static_cast<int>(2 * half);
+    cv::rectangle(image, cv::Rect(pixel(*ip - cv::Point2d(half, half)), cv::Size(side, side)),
+                  colour);
   }
 }
 
-/// Text whose top-left corner is inside the picture (vpFont clips nothing).
-void text(vpImage<vpRGBa>& image, const vpFont& font, const std::string& s, const vpImagePoint& at,
-          const vpColor& colour) {
-  if (at.get_i() >= 0 && at.get_j() >= 0 && at.get_i() < kHeight - 12 && at.get_j() < kWidth - 8) {
-    font.drawText(image, s, at, colour);
+/// Text whose top-left corner is `at`, drawn only when that corner is inside the picture.
+void text(cv::Mat& image, const std::string& s, const cv::Point2d& at, const cv::Scalar& colour) {
+  if (at.x >= 0 && at.y >= 0 && at.y < kHeight - 12 && at.x < kWidth - 8) {
+    constexpr double kScale = 0.45;
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, kScale, 1, &baseline);
+    cv::putText(image, s, pixel(at) + cv::Point(0, size.height), cv::FONT_HERSHEY_SIMPLEX, kScale,
+                colour, 1, cv::LINE_AA);
   }
 }
 
-void marker(vpImage<vpRGBa>& image, const vpFont& font, const Observer& obs,
-            const Eigen::Vector3d& p, const vpColor& colour, const std::string& label) {
+void marker(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+            const std::string& label) {
   if (const auto ip = obs(p)) {
-    vpImageDraw::drawCircle(image, *ip, 7, colour, 2);
-    text(image, font, label, vpImagePoint(ip->get_i() - 22, ip->get_j() + 8), colour);
+    cv::circle(image, pixel(*ip), 7, colour, 2);
+    text(image, label, *ip + cv::Point2d(8, -22), colour);
   }
 }
 
@@ -102,8 +121,7 @@ void marker(vpImage<vpRGBa>& image, const vpFont& font, const Observer& obs,
 void save_perception_picture(const std::string& path, const RgbdFrame& frame,
                              const PerceptionResult& r, const std::optional<ViewEstimate>& e,
                              double r_sphere) {
-  vpImage<vpRGBa> image(kHeight, kWidth, vpRGBa(24, 24, 32));
-  const vpFont font(16, vpFont::GENERIC_MONOSPACE);
+  cv::Mat image(kHeight, kWidth, CV_8UC3, rgb(24, 24, 32));
   const bool tracked = r.status != TrackingStatus::Lost;
   const Eigen::Vector3d c = tracked ? r.centroid : frame.wMc * Eigen::Vector3d(0, 0, 0.5);
   const Eigen::Vector3d camera = frame.wMc.translation();
@@ -120,13 +138,7 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
       (Eigen::AngleAxisd(55.0 * M_PI / 180.0, cam_up) * back + 0.5 * cam_up).normalized();
   const Observer obs(c + 2.4 * r_sphere * dir, c, cam_up, 0.9 * kHeight);
 
-  // Background and other voxels, faint; the sphere as three great circles.
-  for (std::size_t i = 0; i < r.voxels.size(); i += 2) {
-    const SupervoxelClass cls = r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label;
-    if (cls == SupervoxelClass::Background || cls == SupervoxelClass::Occluder) {
-      dot(image, obs, r.voxels[i].cast<double>(), vpColor(90, 90, 100));
-    }
-  }
+  // The sphere as three great circles.
   if (tracked) {
     const Eigen::Matrix3d& a = r.axes;
     for (int k = 0; k < 3; ++k) {
@@ -135,21 +147,21 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
       for (int s = 0; s < 72; ++s) {
         const double t0 = 2 * M_PI * s / 72, t1 = 2 * M_PI * (s + 1) / 72;
         line(image, obs, c + r_sphere * (std::cos(t0) * u + std::sin(t0) * v),
-             c + r_sphere * (std::cos(t1) * u + std::sin(t1) * v), vpColor(70, 70, 110));
+             c + r_sphere * (std::cos(t1) * u + std::sin(t1) * v), rgb(70, 70, 110));
       }
     }
   }
   // Occluders: small red squares, under everything else.
   for (Eigen::Index b = 0; b < r.problem.occluders.cols(); ++b) {
-    square(image, obs, r.problem.occluders.col(b), vpColor(200, 40, 40), 1.5);
+    square(image, obs, r.problem.occluders.col(b), rgb(200, 40, 40), 1.5);
   }
   // Interacting (yellow) and object (green) voxels.
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const SupervoxelClass cls = r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label;
     if (cls == SupervoxelClass::Object) {
-      dot(image, obs, r.voxels[i].cast<double>(), vpColor(60, 220, 90), 3);
+      dot(image, obs, r.voxels[i].cast<double>(), rgb(60, 220, 90), 2);
     } else if (cls == SupervoxelClass::Interacting) {
-      dot(image, obs, r.voxels[i].cast<double>(), vpColor(230, 200, 40), 2);
+      dot(image, obs, r.voxels[i].cast<double>(), rgb(230, 200, 40), 1);
     }
   }
   if (tracked) {
@@ -164,7 +176,7 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
       for (int bit : {1, 2, 4}) {
         if ((k & bit) == 0) {
           line(image, obs, corner[static_cast<std::size_t>(k)],
-               corner[static_cast<std::size_t>(k | bit)], vpColor(60, 220, 120));
+               corner[static_cast<std::size_t>(k | bit)], rgb(60, 220, 120));
         }
       }
     }
@@ -174,19 +186,19 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
       const Eigen::Vector3d v = p.positions.col(n);
       const Eigen::Vector3d nn = p.normals.col(n).normalized();
       if ((v - c).norm() < r_sphere) {
-        line(image, obs, c, sphere_exit(c, r_sphere, v, nn), vpColor(70, 110, 255));
+        line(image, obs, c, sphere_exit(c, r_sphere, v, nn), rgb(70, 110, 255));
       }
-      line(image, obs, v, v + 0.03 * nn, vpColor(255, 90, 90));
+      line(image, obs, v, v + 0.03 * nn, rgb(255, 90, 90));
     }
   }
   // Cameras.
-  marker(image, font, obs, camera, vpColor::white, "t_real");
-  line(image, obs, camera, camera + 0.08 * frame.wMc.linear().col(2), vpColor::white, 2);
+  marker(image, obs, camera, kWhite, "t_real");
+  line(image, obs, camera, camera + 0.08 * frame.wMc.linear().col(2), kWhite, 2);
   if (e) {
-    line(image, obs, c, e->t0, vpColor::cyan, 2);
-    line(image, obs, c, e->tf, vpColor(255, 60, 255), 2);
-    marker(image, font, obs, e->t0, vpColor::cyan, "t0");
-    marker(image, font, obs, e->tf, vpColor(255, 60, 255), "tf");
+    line(image, obs, c, e->t0, kCyan, 2);
+    line(image, obs, c, e->tf, kMagenta, 2);
+    marker(image, obs, e->t0, kCyan, "t0");
+    marker(image, obs, e->tf, kMagenta, "tf");
   }
 
   // Inset: the camera image, object supervoxel centroids in green, occluders in red.
@@ -199,11 +211,12 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
       const int su = std::min(k.width - 1, static_cast<int>(u * s));
       const int sv = std::min(k.height - 1, static_cast<int>(v * s));
       const std::size_t i = frame.index(su, sv);
+      cv::Vec3b& out = image.at<cv::Vec3b>(v + 8, u + 8);
       if (!frame.rgb.empty()) {
-        image[v + 8][u + 8] = vpRGBa(frame.rgb[3 * i], frame.rgb[3 * i + 1], frame.rgb[3 * i + 2]);
+        out = cv::Vec3b(frame.rgb[3 * i + 2], frame.rgb[3 * i + 1], frame.rgb[3 * i]);
       } else {
         const auto g = static_cast<unsigned char>(std::min(255.0f, frame.depth[i] * 100.0f));
-        image[v + 8][u + 8] = vpRGBa(g, g, g);
+        out = cv::Vec3b(g, g, g);
       }
     }
   }
@@ -222,12 +235,12 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
     if (u < 8 || v < 8 || u >= inset_w + 8 || v >= inset_h + 8) {
       continue;
     }
-    const vpColor colour = sv.label == SupervoxelClass::Object        ? vpColor(60, 220, 90)
-                           : sv.label == SupervoxelClass::Interacting ? vpColor(240, 210, 40)
-                                                                      : vpColor(240, 40, 40);
-    vpImageDraw::drawPoint(image, vpImagePoint(v, u), colour, 2);
+    const cv::Scalar colour = sv.label == SupervoxelClass::Object        ? rgb(60, 220, 90)
+                              : sv.label == SupervoxelClass::Interacting ? rgb(240, 210, 40)
+                                                                         : rgb(240, 40, 40);
+    point(image, cv::Point2d(u, v), colour, 1);
   }
-  vpImageDraw::drawRectangle(image, vpRect(7, 7, inset_w + 2, inset_h + 2), vpColor::white);
+  cv::rectangle(image, cv::Rect(7, 7, inset_w + 2, inset_h + 2), kWhite);
 
   // Legend and figures.
   char line1[256];
@@ -235,22 +248,26 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
   std::snprintf(line1, sizeof line1, "t=%.3fs  %s  N=%zu  interacting=%zu  occluders=%zu",
                 frame.timestamp, to_string(r.status), r.counts.object, r.counts.interacting,
                 r.counts.occluders);
-  text(image, font, line1, vpImagePoint(kHeight - 48, 10), vpColor::white);
+  text(image, line1, cv::Point2d(10, kHeight - 48), kWhite);
   if (e) {
     std::snprintf(line2, sizeof line2, "%s, %d iterations, tf-t0 %.1f deg, front end %.1f ms",
                   to_string(e->status), e->iterations, e->tf_to_t0_deg, r.timings.total);
   } else {
     std::snprintf(line2, sizeof line2, "object lost: %s", r.message.c_str());
   }
-  text(image, font, line2, vpImagePoint(kHeight - 26, 10), vpColor::white);
-  text(image, font, "green object, yellow interacting, red occluders, blue S_n rays, red normals",
-       vpImagePoint(kHeight - 70, 10), vpColor(160, 160, 170));
+  text(image, line2, cv::Point2d(10, kHeight - 26), kWhite);
+  text(image, "green object, yellow interacting, red occluders, blue S_n rays, red normals",
+       cv::Point2d(10, kHeight - 70), rgb(160, 160, 170));
 
+  bool written = false;
   try {
-    vpImageIo::write(image, path);
-  } catch (const std::exception& ex) {
+    written = cv::imwrite(path, image);
+  } catch (const cv::Exception& ex) {
     throw std::runtime_error(path + ": cannot write the picture: " + ex.what());
+  }
+  if (!written) {
+    throw std::runtime_error(path + ": cannot write the picture");
   }
 }
 
-}  // namespace ofv::cli
+}  // namespace ofv

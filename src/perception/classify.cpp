@@ -1,0 +1,139 @@
+// The tracked object's shape (C, PCA axes, augmented OBB), the class of every
+// supervoxel (paper II-B) and the estimator's ViewProblem.
+#include "front_end.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <limits>
+#include <vector>
+
+namespace ofv {
+
+namespace {
+
+/// C, the mean of `points`, and their principal axes (columns, largest
+/// variance first, right-handed).
+void principal_axes(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d& c,
+                    Eigen::Matrix3d& axes) {
+  c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) {
+    c += p;
+  }
+  c /= static_cast<double>(points.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) {
+    cov += (p - c) * (p - c).transpose();
+  }
+  cov /= static_cast<double>(points.size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  axes.col(0) = eig.eigenvectors().col(2);  // largest variance
+  axes.col(1) = eig.eigenvectors().col(1);
+  axes.col(2) = axes.col(0).cross(axes.col(1));
+}
+
+/// The augmented OBB: extents of `points` along `axes` from c, plus `margin` on every side.
+OrientedBox augmented_obb(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& c,
+                          const Eigen::Matrix3d& axes, double margin) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d local = axes.transpose() * (p - c);
+    lo = lo.cwiseMin(local);
+    hi = hi.cwiseMax(local);
+  }
+  OrientedBox obb;
+  obb.axes = axes;
+  obb.centre = c + axes * (0.5 * (lo + hi));
+  obb.half_extents = 0.5 * (hi - lo) + Eigen::Vector3d::Constant(margin);
+  return obb;
+}
+
+}  // namespace
+
+void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& object) {
+  const std::size_t n = r.supervoxels.size();
+  // The object's voxel cloud: what is seen of it, plus the remembered voxels
+  // of its part hidden behind something nearer the camera, so that an
+  // occluder does not drag C, the axes and the OBB towards the visible part.
+  object_cloud.clear();
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (object[static_cast<std::size_t>(r.voxel_owner[i])]) {
+      object_cloud.push_back(r.voxels[i].cast<double>());
+    }
+  }
+  r.counts.object_voxels = object_cloud.size();
+  for (std::size_t i = 0; i < memory.size(); ++i) {
+    if (memory_age[i] > 0) {
+      object_cloud.push_back(memory[i].cast<double>());
+    }
+  }
+  r.counts.hidden_voxels = object_cloud.size() - r.counts.object_voxels;
+
+  Eigen::Vector3d c;
+  Eigen::Matrix3d axes;
+  principal_axes(object_cloud, c, axes);
+  r.centroid = c;
+  r.axes = axes;
+  r.obb = augmented_obb(object_cloud, c, axes, settings.obb_margin);
+
+  // Labels (paper II-B) and the estimator's input.
+  std::vector<int> vertices;
+  std::vector<int> occluders;
+  for (std::size_t i = 0; i < n; ++i) {
+    SupervoxelInfo& s = r.supervoxels[i];
+    if (object[i]) {
+      s.label = SupervoxelClass::Object;
+      ++r.counts.object;
+      if (s.normal_valid) {
+        vertices.push_back(static_cast<int>(i));
+      }
+    } else if (!settings.support_plane_occludes && on_plane(s)) {
+      s.label = SupervoxelClass::Background;
+    } else if (r.obb.contains(s.centroid)) {
+      s.label = SupervoxelClass::Interacting;
+      ++r.counts.interacting;
+    } else if ((s.centroid - c).norm() < settings.r_sphere) {
+      s.label = SupervoxelClass::Occluder;
+      ++r.counts.occluders;
+      occluders.push_back(static_cast<int>(i));
+    } else {
+      s.label = SupervoxelClass::Background;
+    }
+  }
+  ViewProblem& p = r.problem;
+  p.positions.resize(3, static_cast<Eigen::Index>(vertices.size()));
+  p.normals.resize(3, static_cast<Eigen::Index>(vertices.size()));
+  for (std::size_t j = 0; j < vertices.size(); ++j) {
+    const SupervoxelInfo& s = r.supervoxels[static_cast<std::size_t>(vertices[j])];
+    p.positions.col(static_cast<Eigen::Index>(j)) = s.centroid;
+    p.normals.col(static_cast<Eigen::Index>(j)) = s.normal;
+  }
+  if (settings.tracking.hidden_vertices) {
+    // The object's remembered supervoxels now hidden: the estimator keeps
+    // them in view too, not only the part that is still seen.
+    Eigen::Index k = p.positions.cols();
+    for (const Vertex& m : vertex_memory) {
+      k += m.age > 0 ? 1 : 0;
+    }
+    p.positions.conservativeResize(3, k);
+    p.normals.conservativeResize(3, k);
+    k = static_cast<Eigen::Index>(vertices.size());
+    for (const Vertex& m : vertex_memory) {
+      if (m.age == 0) continue;
+      p.positions.col(k) = m.centroid;
+      p.normals.col(k) = m.normal;
+      ++k;
+    }
+    r.counts.hidden_vertices = static_cast<std::size_t>(k) - vertices.size();
+  }
+  p.occluders.resize(3, static_cast<Eigen::Index>(occluders.size()));
+  for (std::size_t j = 0; j < occluders.size(); ++j) {
+    p.occluders.col(static_cast<Eigen::Index>(j)) =
+        r.supervoxels[static_cast<std::size_t>(occluders[j])].centroid;
+  }
+  p.centroid = c;
+  p.axes = axes;
+  p.camera = r.wMc.translation();
+}
+
+}  // namespace ofv

@@ -1,0 +1,148 @@
+// Internal: the state Perception carries from frame to frame, and its stages,
+// one file each along the frame's path:
+//   pipeline.cpp          the per-frame sequence (cloud, supervoxels, adjacency, ...)
+//   object_selection.cpp  the first frame: support plane, then the object by box, image or cluster
+//   object_memory.cpp     later frames: the object found near its remembered voxels; the
+//                         memory updated, hidden voxels and supervoxels kept for a while
+//   classify.cpp          PCA, augmented OBB, interacting / occluders, the ViewProblem
+#pragma once
+
+#include "ofv/perception/cloud.h"
+#include "ofv/perception/perception.h"
+
+#include "pcl_stages.h"
+#include "point_grid.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ofv {
+
+namespace detail {
+
+/// Colour without brightness: R, G, B over their sum (shading-invariant).
+inline Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) {
+  return rgb / std::max(rgb.sum(), 1.0f);
+}
+
+/// Pixel of world point p in the frame's camera; nullopt behind the camera.
+inline std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eigen::Isometry3d& cMw,
+                                              const Eigen::Vector3d& p, double* depth = nullptr) {
+  const Eigen::Vector3d pc = cMw * p;
+  if (!(pc.z() > 1e-6)) {
+    return std::nullopt;
+  }
+  if (depth != nullptr) {
+    *depth = pc.z();
+  }
+  const CameraIntrinsics& k = frame.intrinsics;
+  return Eigen::Vector2d(k.fx * pc.x() / pc.z() + k.cx, k.fy * pc.y() / pc.z() + k.cy);
+}
+
+/// True when world point p cannot be seen in the frame: out of the image, or
+/// behind a surface nearer the camera by more than `tolerance` [m].
+inline bool hidden(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
+                   double tolerance) {
+  double z = 0.0;
+  const auto px = project(frame, cMw, p, &z);
+  if (!px) return true;
+  const int u = static_cast<int>(std::lround(px->x()));
+  const int v = static_cast<int>(std::lround(px->y()));
+  const CameraIntrinsics& k = frame.intrinsics;
+  if (u < 0 || v < 0 || u >= k.width || v >= k.height) return true;
+  const float observed = frame.depth[frame.index(u, v)];
+  return std::isfinite(observed) && observed > 0.0f &&
+         static_cast<double>(observed) < z - tolerance;
+}
+
+}  // namespace detail
+
+struct Perception::Impl {
+  explicit Impl(const PerceptionSettings& s) : settings(s), builder(cloud_settings(s)) {}
+
+  static CloudSettings cloud_settings(const PerceptionSettings& s) {
+    CloudSettings c = s.cloud;
+    c.voxel_resolution = s.supervoxels.voxel_resolution;
+    return c;
+  }
+
+  PerceptionSettings settings;
+
+  // Buffers reused from frame to frame.
+  CloudBuilder builder;
+  WorldCloud cloud;
+  detail::SupervoxelOutput sv;
+  detail::PointGrid grid;  // for adjacency and tracking
+  std::vector<Eigen::Vector3f> centroids;
+  std::vector<Eigen::Vector3d> object_cloud;  // classify(): visible + hidden object voxels
+  // Per voxel of the current frame: may it enter the object state? In
+  // tracking only voxels that matched the state themselves do, so the
+  // foreign voxels of a mixed boundary supervoxel (a hand's, the table's)
+  // never become object and cannot pull their neighbours in next frame.
+  std::vector<char> voxel_matched;
+
+  // Object state carried from frame to frame (world frame).
+  bool initialised = false;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3f> memory;  // object voxels: seen now, or hidden behind something
+  std::vector<Eigen::Vector3f> memory_chroma;  // chromaticity of each memory voxel
+  std::vector<int> memory_age;                 // frames since the voxel was last seen
+  struct Vertex {
+    Eigen::Vector3d centroid, normal;
+    int age = 0;  // frames since it was last seen
+  };
+  std::vector<Vertex> vertex_memory;     // object supervoxels: seen now, or hidden behind something
+  std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
+  std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
+  Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
+
+  /// True for a voxel of the support plane: on it, and of its colour.
+  [[nodiscard]] bool plane_voxel(const Eigen::Vector3f& p, const Eigen::Vector3f& rgb) const {
+    return plane &&
+           std::abs(plane->head<3>().cast<float>().dot(p) + static_cast<float>((*plane)(3))) <=
+               static_cast<float>(settings.tracking.plane_distance) &&
+           (settings.tracking.max_chroma_distance <= 0.0 ||
+            (detail::chroma(rgb) - plane_chroma).norm() <=
+                static_cast<float>(settings.tracking.max_chroma_distance));
+  }
+
+  /// True for a supervoxel lying on the support plane: centroid on it and
+  /// normal within 60 degrees of the plane's. The foot of an object standing
+  /// on the plane is near it too, but faces another way; supervoxels that
+  /// straddle the foot and the plane have normals in between and go with
+  /// the plane.
+  [[nodiscard]] bool on_plane(const SupervoxelInfo& s) const {
+    return plane &&
+           std::abs(plane->head<3>().dot(s.centroid) + (*plane)(3)) <=
+               settings.tracking.plane_distance &&
+           std::abs(plane->head<3>().dot(s.normal)) >= std::cos(M_PI / 3.0);
+  }
+
+  // The stages, in the order process() runs them.
+
+  /// pipeline.cpp: the whole frame.
+  PerceptionResult process(const RgbdFrame& frame);
+  /// pipeline.cpp: r.adjacency, the pairs of supervoxels within R_adj (paper eq. 1).
+  void adjacency(PerceptionResult& r);
+  /// object_selection.cpp: the first frame's object supervoxels (1 = object);
+  /// fits the support plane and sets voxel_matched. `why` says why none is found.
+  std::vector<char> select(const RgbdFrame& frame, const PerceptionResult& r, std::string& why);
+  /// object_memory.cpp: a later frame's object supervoxels, those near the
+  /// remembered object voxels; sets voxel_matched.
+  std::vector<char> track(const PerceptionResult& r);
+  /// pipeline.cpp: r.status and r.message from the object found; the first
+  /// frame found also sets the state's start (initialised, initial_voxels).
+  void set_status(PerceptionResult& r, const std::vector<char>& object, std::string why);
+  /// object_memory.cpp: the memory updated with the frame's object.
+  void remember(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<char>& object);
+  /// classify.cpp: C, axes, OBB, labels and r.problem.
+  void classify(PerceptionResult& r, const std::vector<char>& object);
+};
+
+}  // namespace ofv

@@ -1,0 +1,91 @@
+// The front end's settings checked, and its closed sets of words.
+#include "ofv/perception/perception.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ofv {
+
+const char* to_string(TrackingStatus status) {
+  switch (status) {
+    case TrackingStatus::Initialised:
+      return "initialised";
+    case TrackingStatus::Tracking:
+      return "tracking";
+    case TrackingStatus::Lost:
+      return "lost";
+  }
+  return "?";
+}
+
+const char* to_string(SupervoxelClass label) {
+  switch (label) {
+    case SupervoxelClass::Object:
+      return "object";
+    case SupervoxelClass::Interacting:
+      return "interacting";
+    case SupervoxelClass::Occluder:
+      return "occluder";
+    case SupervoxelClass::Background:
+      return "background";
+  }
+  return "?";
+}
+
+namespace {
+
+void require(bool ok, const char* name, double value, const char* expected) {
+  if (!ok) {
+    throw std::invalid_argument(std::string("perception setting ") + name + " = " +
+                                std::to_string(value) + ": expected " + expected);
+  }
+}
+
+bool positive(double x) { return std::isfinite(x) && x > 0.0; }
+
+}  // namespace
+
+void validate(const PerceptionSettings& s) {
+  const SupervoxelSettings& sv = s.supervoxels;
+  require(positive(sv.voxel_resolution), "voxel_resolution", sv.voxel_resolution, "> 0 [m]");
+  require(positive(sv.seed_resolution) && sv.seed_resolution >= sv.voxel_resolution,
+          "seed_resolution", sv.seed_resolution, ">= voxel_resolution [m]");
+  require(std::isfinite(sv.colour_importance) && sv.colour_importance >= 0.0, "colour_importance",
+          sv.colour_importance, ">= 0");
+  require(std::isfinite(sv.spatial_importance) && sv.spatial_importance >= 0.0,
+          "spatial_importance", sv.spatial_importance, ">= 0");
+  require(std::isfinite(sv.normal_importance) && sv.normal_importance >= 0.0, "normal_importance",
+          sv.normal_importance, ">= 0");
+  require(sv.adjacency_alpha >= 1.0 && sv.adjacency_alpha <= 1.5, "adjacency_alpha",
+          sv.adjacency_alpha, "in [1, 1.5] (paper eq. 1)");
+  const TrackingSettings& t = s.tracking;
+  require(positive(t.max_motion), "max_motion", t.max_motion, "> 0 [m]");
+  require(t.min_near_fraction > 0.0 && t.min_near_fraction <= 1.0, "min_near_fraction",
+          t.min_near_fraction, "in (0, 1]");
+  require(t.min_kept_fraction >= 0.0 && t.min_kept_fraction <= 1.0, "min_kept_fraction",
+          t.min_kept_fraction, "in [0, 1]");
+  require(std::isfinite(t.max_chroma_distance), "max_chroma_distance", t.max_chroma_distance,
+          "a finite number (<= 0: off)");
+  require(positive(t.plane_distance), "plane_distance", t.plane_distance, "> 0 [m]");
+  require(t.min_cluster_supervoxels >= 1, "min_cluster_supervoxels", t.min_cluster_supervoxels,
+          ">= 1");
+  require(t.occlusion_memory_frames >= 0, "occlusion_memory_frames", t.occlusion_memory_frames,
+          ">= 0");
+  require(s.cloud.pixel_stride >= 1, "pixel_stride", s.cloud.pixel_stride, ">= 1");
+  require(positive(s.r_sphere), "r_sphere", s.r_sphere, "> 0 [m]");
+  require(std::isfinite(s.crop_margin) && s.crop_margin >= 0.0, "crop_margin", s.crop_margin,
+          ">= 0 [m]");
+  require(positive(s.max_depth), "max_depth", s.max_depth, "> 0 [m]");
+  require(std::isfinite(s.obb_margin) && s.obb_margin >= 0.0, "obb_margin", s.obb_margin,
+          ">= 0 [m]");
+  if (s.selection.mode == ObjectSelection::Mode::Box && s.selection.box.isEmpty()) {
+    throw std::invalid_argument("perception selection: mode box needs a non-empty box");
+  }
+  if (s.selection.mode == ObjectSelection::Mode::Image && s.selection.mask.empty() &&
+      s.selection.rect.isEmpty()) {
+    throw std::invalid_argument("perception selection: mode image needs a rectangle or a mask");
+  }
+}
+
+}  // namespace ofv
