@@ -1,4 +1,5 @@
 // The estimator against hand-computed geometry and invariants (ESTIMATOR-SPEC.md).
+#include "ofv/constants.h"
 #include "ofv/estimator.h"
 
 #include <Eigen/Geometry>
@@ -12,7 +13,7 @@ namespace ofv {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = kPi / 180.0;
 
 Eigen::Matrix3Xd cols(std::initializer_list<Eigen::Vector3d> points) {
   Eigen::Matrix3Xd m(3, static_cast<Eigen::Index>(points.size()));
@@ -465,8 +466,8 @@ TEST(Geometry, SphereExitFromInsideLandsOnTheSphere) {
     EXPECT_GT((s - o).dot(dir), 0.0);
     EXPECT_LT((s - o).normalized().cross(dir.normalized()).norm(), 1e-12);
   }
-  EXPECT_NEAR(angle_between({1, 0, 0}, {0, 2, 0}), 3.14159265358979323846 / 2, 1e-15);
-  EXPECT_NEAR(angle_between({1, 0, 0}, {-1, 1e-20, 0}), 3.14159265358979323846, 1e-15);
+  EXPECT_NEAR(angle_between({1, 0, 0}, {0, 2, 0}), kPi / 2, 1e-15);
+  EXPECT_NEAR(angle_between({1, 0, 0}, {-1, 1e-20, 0}), kPi, 1e-15);
 }
 
 }  // namespace
