@@ -115,11 +115,6 @@ struct ObjectFrame {
   bool from_world = false;  // the world axes stand in for undetermined PCA axes
 };
 
-// Inputs: C, given or the mean of `points`.
-Eigen::Vector3d object_centroid(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
-  return problem.centroid ? *problem.centroid : Eigen::Vector3d(points.rowwise().mean());
-}
-
 // Inputs and §2: given axes normalised (checked by check_inputs), else PCA of
 // `points`, with the world axes standing in when PCA does not determine e1
 // (N <= 1, or lambda1 - lambda2 <= 1e-9 lambda1).
@@ -151,6 +146,14 @@ ObjectFrame object_axes(const ViewProblem& problem, const Eigen::Matrix3Xd& poin
   frame.e.setIdentity();
   frame.determined = false;
   frame.from_world = true;
+  return frame;
+}
+
+// Inputs: C (given, or the mean of `points`) and the axes, from the usable
+// supervoxels' positions `points` (3 x N, N >= 1 unless C is given).
+ObjectFrame object_frame(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
+  ObjectFrame frame = object_axes(problem, points);
+  frame.c = problem.centroid ? *problem.centroid : Eigen::Vector3d(points.rowwise().mean());
   return frame;
 }
 
@@ -572,22 +575,22 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   const double r = settings.r_sphere;
   ViewEstimate est;
 
-  // Inputs, §7: usable supervoxels, C and the object axes.
+  // Inputs, §7: C and the axes describe the whole object, so they come from
+  // every usable supervoxel, also those §1 then skips for lying at or outside
+  // the sphere (which is judged against this C).
   const Supervoxels supervoxels = usable_supervoxels(problem);
   if (!problem.centroid && supervoxels.size() == 0) {
     usage_error("no usable supervoxel and no centroid given");
   }
-  const Eigen::Vector3d c = object_centroid(problem, supervoxels.v);
+  const ObjectFrame object = object_frame(problem, supervoxels.v);
+  const Eigen::Vector3d& c = object.c;
+  est.centroid = c;
+  est.axes = object.e;
+  est.axes_from_world = object.from_world;
 
   // §1: normals-to-sphere rays.
   const NormalRays rays = normals_to_sphere_rays(supervoxels, c, r);
   est.skipped_supervoxels = static_cast<int>(problem.positions.cols() - rays.size());
-
-  ObjectFrame object = object_axes(problem, rays.v);
-  object.c = c;
-  est.centroid = c;
-  est.axes = object.e;
-  est.axes_from_world = object.from_world;
 
   // §2: initial view t0.
   const InitialViewChoice initial =

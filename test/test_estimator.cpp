@@ -154,6 +154,37 @@ TEST(Estimator, SupervoxelAtTheSphereBoundaryIsSkipped) {
   EXPECT_EQ(e.skipped_supervoxels, 1);
 }
 
+// Spec, Inputs: skipping removes a supervoxel's ray, never its part in C or
+// in the PCA. A cross longer in x than in y has C = (0, 0, 1) and e1 = x; a
+// fifth supervoxel F = (0, 2, 1) far along y moves C to the mean of the five,
+// (0, 0.4, 1), which leaves F 1.6 m away (outside R = 0.5: skipped) and the
+// other four inside (at most sqrt(0.1^2 + 0.4^2) = 0.41 m and 0.45 m). With F
+// the covariance is diag(0.02/5, 3.205/5, 0) (cov_xy = 0.1*0.4 - 0.1*0.4 = 0),
+// so e1 = +-y.
+TEST(Estimator, SkippedSupervoxelStillMovesTheCentroidAndTheAxes) {
+  ViewProblem cross;
+  cross.positions = cols({{-0.1, 0, 1}, {0.1, 0, 1}, {0, -0.05, 1}, {0, 0.05, 1}});
+  cross.normals = cols({{0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0, 0, -1}});
+  cross.occluders = cols({{0.02, 0.03, 0.6}});
+  const ViewEstimate without = estimate_view(cross, EstimatorSettings{});
+  EXPECT_EQ(without.skipped_supervoxels, 0);
+  EXPECT_TRUE(without.centroid.isApprox(Eigen::Vector3d(0, 0, 1), 1e-15));
+  EXPECT_NEAR(std::abs(without.axes.col(0).x()), 1.0, 1e-12);
+
+  ViewProblem with_far = cross;
+  with_far.positions = cols({{-0.1, 0, 1}, {0.1, 0, 1}, {0, -0.05, 1}, {0, 0.05, 1}, {0, 2, 1}});
+  with_far.normals = cols({{0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0, 0, -1}});
+  const ViewEstimate e = estimate_view(with_far, EstimatorSettings{});
+  EXPECT_EQ(e.skipped_supervoxels, 1);
+  EXPECT_EQ(e.occlusion_points, 4);  // F has no ray: 4 supervoxels x 1 occluder
+  EXPECT_NEAR((e.centroid - Eigen::Vector3d(0, 0.4, 1)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(std::abs(e.axes.col(0).y()), 1.0, 1e-12);
+  EXPECT_FALSE(e.axes_from_world);
+  EXPECT_NEAR(e.axes.col(0).cross(e.axes.col(1)).dot(e.axes.col(2)), 1.0, 1e-12);
+  // t0 lies on the sphere about the moved C.
+  EXPECT_NEAR((e.t0 - e.centroid).norm(), 0.5, 1e-12);
+}
+
 TEST(Estimator, AllSupervoxelsOutsideTheSphereFallBackToTheCamera) {
   ViewProblem p;
   p.positions = cols({{1, 0, 0}, {-1, 0, 0}});

@@ -110,8 +110,11 @@ struct ViewProblem {
   Eigen::Matrix3Xd positions;  ///< 3 x N object supervoxel centroids v_n
   Eigen::Matrix3Xd normals;    ///< 3 x N supervoxel normals p_n (any length > 1e-12)
   Eigen::Matrix3Xd occluders;  ///< 3 x B occluder points q_b (may be empty)
-  std::optional<Eigen::Vector3d> centroid;       ///< C; default: mean of the valid v_n
-  std::optional<Eigen::Matrix3d> axes;           ///< columns e1, e2, e3; default: PCA of the v_n
+  /// C; default: mean of every usable v_n (spec §7), also those at or outside the sphere.
+  std::optional<Eigen::Vector3d> centroid;
+  /// Columns e1, e2, e3; default: PCA of the same v_n as C (a supervoxel skipped
+  /// by spec §1 loses its ray, never its part in C or the axes).
+  std::optional<Eigen::Matrix3d> axes;
   std::optional<Eigen::Vector3d> camera;         ///< current camera position (t0's last fallback)
   std::optional<Eigen::Vector3d> previous_view;  ///< previous t_f, used with warm_start
 };
