@@ -107,6 +107,19 @@ Eigen::Matrix3Xd usable_occluders(const Eigen::Matrix3Xd& occluders) {
   return q;
 }
 
+// No usable supervoxel and no C given: nothing to look at. The camera stays
+// where it is (t0 = tf = camera, or zero without one).
+ViewEstimate no_supervoxels(const ViewProblem& problem) {
+  ViewEstimate est;
+  est.status = ViewStatus::NoSupervoxels;
+  est.t0 = est.tf = problem.camera.value_or(Eigen::Vector3d::Zero());
+  est.iterations = 0;
+  est.skipped_supervoxels = static_cast<int>(problem.positions.cols());
+  est.skipped_occluders =
+      static_cast<int>(problem.occluders.cols() - usable_occluders(problem.occluders).cols());
+  return est;
+}
+
 // C and the object axes e1, e2, e3 (columns of e).
 struct ObjectFrame {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
@@ -580,7 +593,7 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   // the sphere (which is judged against this C).
   const Supervoxels supervoxels = usable_supervoxels(problem);
   if (!problem.centroid && supervoxels.size() == 0) {
-    usage_error("no usable supervoxel and no centroid given");
+    return no_supervoxels(problem);
   }
   const ObjectFrame object = object_frame(problem, supervoxels.v);
   const Eigen::Vector3d& c = object.c;

@@ -74,6 +74,7 @@ const char* to_string(ViewStatus v) {
     case ViewStatus::Converged: return "converged";
     case ViewStatus::NotConverged: return "not_converged";
     case ViewStatus::NoOccluders: return "no_occluders";
+    case ViewStatus::NoSupervoxels: return "no_supervoxels";
   }
   return "?";
 }

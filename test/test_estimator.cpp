@@ -229,12 +229,56 @@ TEST(Estimator, InvalidSupervoxelsAndOccludersAreSkippedAndCounted) {
   EXPECT_EQ(e.occlusion_points, 3);  // 3 usable supervoxels x 1 occluder
 }
 
-TEST(Estimator, NoUsableSupervoxelAndNoCentroidIsAUsageError) {
-  ViewProblem p = single_supervoxel();
-  p.normals.setZero();
-  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+TEST(Estimator, NoUsableSupervoxelAndNoCentroidIsTheNoSupervoxelsOutcome) {
   ViewProblem empty;
-  EXPECT_THROW((void)estimate_view(empty, EstimatorSettings{}), std::invalid_argument);
+  const ViewEstimate e = estimate_view(empty, EstimatorSettings{});
+  EXPECT_EQ(e.status, ViewStatus::NoSupervoxels);
+  EXPECT_STREQ(to_string(e.status), "no_supervoxels");
+  EXPECT_EQ(e.t0, Eigen::Vector3d::Zero());
+  EXPECT_EQ(e.tf, Eigen::Vector3d::Zero());
+  EXPECT_EQ(e.iterations, 0);
+  EXPECT_FALSE(e.error_t0);
+  EXPECT_FALSE(e.error_tf);
+
+  // Every supervoxel unusable by §7; the camera stays where it is.
+  ViewProblem p = patch(2, 2, 0.02);
+  p.normals.col(0).setZero();
+  p.normals(2, 1) = kNaN;
+  p.positions(0, 2) = std::numeric_limits<double>::infinity();
+  p.normals.col(3) *= 1e-13;
+  p.occluders = cols({{0, 0, 0.7}, {kNaN, 0, 0.7}});
+  p.camera = Eigen::Vector3d(0.1, 0.2, 0.3);
+  const ViewEstimate f = estimate_view(p, EstimatorSettings{}, {true});
+  EXPECT_EQ(f.status, ViewStatus::NoSupervoxels);
+  EXPECT_EQ(f.t0, *p.camera);
+  EXPECT_EQ(f.tf, *p.camera);
+  EXPECT_EQ(f.iterations, 0);
+  EXPECT_EQ(f.skipped_supervoxels, 4);
+  EXPECT_EQ(f.skipped_occluders, 1);
+  EXPECT_FALSE(f.error_t0);
+  EXPECT_FALSE(f.error_tf);
+
+  // With a given centroid there is something to look at: the §2 fallbacks apply.
+  p.centroid = Eigen::Vector3d(0, 0, 1);
+  const ViewEstimate g = estimate_view(p, EstimatorSettings{});
+  EXPECT_NE(g.status, ViewStatus::NoSupervoxels);
+  EXPECT_EQ(g.initial_view_used, InitialViewUsed::Camera);
+}
+
+TEST(Estimator, InvalidInputStillThrowsWithoutUsableSupervoxels) {
+  ViewProblem p;
+  EstimatorSettings s;
+  s.step = 0.0;
+  EXPECT_THROW((void)estimate_view(p, s), std::invalid_argument);
+  p.camera = Eigen::Vector3d(kNaN, 0, 0);
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  p.camera.reset();
+  p.axes = Eigen::Matrix3d::Zero();
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  p.axes.reset();
+  p.positions.resize(3, 1);
+  p.positions.setZero();
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
 }
 
 TEST(Estimator, NormalsAreNormalised) {
@@ -275,7 +319,13 @@ TEST(Estimator, GivenAxesMustBeFiniteAndNonZero) {
   ViewProblem p = patch(3, 2, 0.02);
   p.axes = Eigen::Matrix3d::Identity();
   p.axes->col(1).setZero();
-  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  try {
+    (void)estimate_view(p, EstimatorSettings{});
+    ADD_FAILURE() << "a zero axis was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("axis e2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("[0, 0, 0]"), std::string::npos) << e.what();
+  }
   p.axes = Eigen::Matrix3d::Identity() * 3.0;  // normalised, not an error
   EXPECT_NO_THROW((void)estimate_view(p, EstimatorSettings{}));
 }

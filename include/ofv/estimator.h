@@ -44,11 +44,17 @@ enum class Preset {
   AuthorsCode,  ///< the authors' public 2020 implementation: step r_seed/2, clearance 2 r_seed, 50 iterations
 };
 
-/// \brief Outcome of the iteration.
+/// \brief Outcome of one estimate: the three of the iteration (spec §4), or
+/// that there was nothing to estimate from.
 enum class ViewStatus {
   Converged,     ///< t_f has no projected occlusion point within `clearance`
   NotConverged,  ///< max_iterations reached; t_f is the best visited iterate
   NoOccluders,   ///< no valid occluder: t_f = t0
+  /// No usable supervoxel (all skipped by spec §7) and no given centroid, so
+  /// neither C nor a view exists: t0 = tf = the camera position if given, else
+  /// zero, no angular errors. A closed loop treats it as the object lost;
+  /// `ofv estimate` as a usage error (spec §8).
+  NoSupervoxels,
 };
 
 /// \brief Which rule produced t0 after the spec's fallbacks (spec §2).
@@ -159,13 +165,21 @@ struct EstimateOptions {
 /**
  * \brief Estimates the occlusion-free view for one frame (spec §1-§6).
  *
+ * A frame with no usable supervoxel and no given centroid is an expected
+ * outcome, not an error: status ViewStatus::NoSupervoxels, t0 = tf = the
+ * camera position if given (else zero), iterations 0, no angular errors,
+ * every supervoxel counted in skipped_supervoxels, the non-finite occluders in
+ * skipped_occluders; the other fields keep their defaults.
+ *
  * \param problem  the frame's supervoxels, occluders and optional inputs (world frame).
  * \param settings validated with validate().
  * \param options  diagnostics switches.
- * \throws std::invalid_argument on usage errors: invalid settings, a
- *         non-finite or zero-length given axis, a non-finite optional point,
- *         mismatched positions/normals, no usable supervoxel and no centroid,
- *         or the camera fallback reached without a usable camera.
+ * \throws std::invalid_argument on invalid input, with a message naming the
+ *         field and the value: invalid settings, a non-finite or zero-length
+ *         given axis, a non-finite optional point, mismatched positions and
+ *         normals, the camera fallback of t0 (spec §2) reached without a
+ *         camera or with the camera at C, or a warm start from a previous
+ *         view at C.
  */
 [[nodiscard]] ViewEstimate estimate_view(const ViewProblem& problem,
                                          const EstimatorSettings& settings,
