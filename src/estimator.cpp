@@ -586,7 +586,6 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
                            const EstimateOptions& options) {
   check_inputs(problem, settings);
   const double r = settings.r_sphere;
-  ViewEstimate est;
 
   // Inputs, §7: C and the axes describe the whole object, so they come from
   // every usable supervoxel, also those §1 then skips for lying at or outside
@@ -597,6 +596,7 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   }
   const ObjectFrame object = object_frame(problem, supervoxels.v);
   const Eigen::Vector3d& c = object.c;
+  ViewEstimate est;
   est.centroid = c;
   est.axes = object.e;
   est.axes_from_world = object.from_world;
