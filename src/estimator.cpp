@@ -1,4 +1,9 @@
-// The occlusion-free view estimator (ESTIMATOR-SPEC.md §1-§7).
+// The occlusion-free view estimator, in the order of ESTIMATOR-SPEC.md:
+// inputs and their hygiene (Inputs, §7), normals-to-sphere rays (§1), the
+// initial view (§2), occlusion-to-sphere rays (§3), the iteration (§4) and the
+// angular errors (§6). estimate_view() at the bottom reads as that sequence.
+#include "estimator_errors.h"
+#include "ofv/constants.h"
 #include "ofv/estimator.h"
 
 #include <Eigen/Eigenvalues>
@@ -6,13 +11,14 @@
 
 #include <cmath>
 #include <limits>
-#include <sstream>
-#include <stdexcept>
 
 namespace ofv {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+using detail::format_value;
+using detail::usage_error;
+
+constexpr double kRadToDeg = 180.0 / kPi;
 
 // Thresholds fixed by the spec.
 constexpr double kCircularMeanEps = 1e-9;   // §2: both sums of a circular mean below this
@@ -25,59 +31,114 @@ constexpr double kZeroPushEps = 1e-12;      // §4: |v| below this
 constexpr double kParallelEps = 1e-9;       // §4: |e1 . w| >= 1 - this
 constexpr double kMinNormal = 1e-12;        // §7: shorter normals are invalid
 
-[[noreturn]] void usage_error(const std::string& what) { throw std::invalid_argument(what); }
+// ---------------------------------------------------------------------------
+// Inputs and §7: what the estimator may use.
 
-std::string format_value(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
-void require_positive(const char* name, double value) {
-  if (!std::isfinite(value) || value <= 0.0) {
-    usage_error(std::string("parameter '") + name + "' must be finite and positive, got " +
-                format_value(value));
+// §7 parameters and the optional inputs: these are usage errors, thrown before
+// any work so that a bad frame never half-succeeds.
+void check_inputs(const ViewProblem& problem, const EstimatorSettings& settings) {
+  validate(settings);
+  if (problem.positions.cols() != problem.normals.cols()) {
+    usage_error("supervoxel positions (" + std::to_string(problem.positions.cols()) +
+                ") and normals (" + std::to_string(problem.normals.cols()) +
+                ") differ in number");
   }
-}
-
-void require_finite(const char* name, const Eigen::Vector3d& p) {
-  if (!p.allFinite()) {
-    usage_error(std::string("'") + name + "' must be finite, got [" + format_value(p.x()) + ", " +
-                format_value(p.y()) + ", " + format_value(p.z()) + "]");
-  }
-}
-
-// Circular mean of angles from their sine and cosine sums; empty when degenerate.
-std::optional<double> circular_mean(double sum_sin, double sum_cos) {
-  if (std::abs(sum_sin) < kCircularMeanEps && std::abs(sum_cos) < kCircularMeanEps) {
-    return std::nullopt;
-  }
-  return std::atan2(sum_sin, sum_cos);
-}
-
-struct Axes {
-  Eigen::Matrix3d e;  // columns e1, e2, e3
-  bool determined = true;
-  bool from_world = false;
-};
-
-// Object axes (spec §2): given axes normalised, else PCA of the points with the
-// world axes standing in when PCA does not determine e1.
-Axes object_axes(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
-  Axes axes;
-  if (problem.axes) {
+  const auto require_finite = [](const char* name, const std::optional<Eigen::Vector3d>& p) {
+    if (p && !p->allFinite()) {
+      usage_error(std::string("'") + name + "' must be finite, got " + format_value(*p));
+    }
+  };
+  require_finite("centroid", problem.centroid);
+  require_finite("camera", problem.camera);
+  require_finite("previous_view", problem.previous_view);
+  if (problem.axes) {  // §2: a zero-length or non-finite given axis
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d e = problem.axes->col(k);
       const double len = e.norm();
       if (!e.allFinite() || !std::isfinite(len) || len <= 0.0) {
-        usage_error("axis e" + std::to_string(k + 1) + " must be finite and non-zero, got [" +
-                    format_value(e.x()) + ", " + format_value(e.y()) + ", " +
-                    format_value(e.z()) + "]");
+        usage_error("axis e" + std::to_string(k + 1) + " must be finite and non-zero, got " +
+                    format_value(e));
       }
-      axes.e.col(k) = e / len;
     }
-    return axes;
+  }
+}
+
+// Supervoxels v_n with their unit normals p_n, one per column.
+struct Supervoxels {
+  Eigen::Matrix3Xd v;
+  Eigen::Matrix3Xd p;
+  [[nodiscard]] Eigen::Index size() const { return v.cols(); }
+};
+
+// §7: supervoxels with a non-finite coordinate or normal, or a normal shorter
+// than 1e-12, are dropped; the others' normals are normalised.
+Supervoxels usable_supervoxels(const ViewProblem& problem) {
+  const Eigen::Index n_in = problem.positions.cols();
+  Supervoxels s;
+  s.v.resize(3, n_in);
+  s.p.resize(3, n_in);
+  Eigen::Index n = 0;
+  for (Eigen::Index k = 0; k < n_in; ++k) {
+    const Eigen::Vector3d v = problem.positions.col(k);
+    const Eigen::Vector3d p = problem.normals.col(k);
+    const double len = p.norm();
+    if (!v.allFinite() || !p.allFinite() || !(len >= kMinNormal)) {
+      continue;
+    }
+    s.v.col(n) = v;
+    s.p.col(n) = p / len;
+    ++n;
+  }
+  s.v.conservativeResize(3, n);
+  s.p.conservativeResize(3, n);
+  return s;
+}
+
+// §7: occluders with a non-finite coordinate are dropped.
+Eigen::Matrix3Xd usable_occluders(const Eigen::Matrix3Xd& occluders) {
+  Eigen::Matrix3Xd q(3, occluders.cols());
+  Eigen::Index b = 0;
+  for (Eigen::Index k = 0; k < occluders.cols(); ++k) {
+    if (occluders.col(k).allFinite()) {
+      q.col(b++) = occluders.col(k);
+    }
+  }
+  q.conservativeResize(3, b);
+  return q;
+}
+
+// No usable supervoxel and no C given: nothing to look at. The camera stays
+// where it is (t0 = tf = camera, or zero without one).
+ViewEstimate no_supervoxels(const ViewProblem& problem) {
+  ViewEstimate est;
+  est.status = ViewStatus::NoSupervoxels;
+  est.t0 = est.tf = problem.camera.value_or(Eigen::Vector3d::Zero());
+  est.iterations = 0;
+  est.skipped_supervoxels = static_cast<int>(problem.positions.cols());
+  est.skipped_occluders =
+      static_cast<int>(problem.occluders.cols() - usable_occluders(problem.occluders).cols());
+  return est;
+}
+
+// C and the object axes e1, e2, e3 (columns of e).
+struct ObjectFrame {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d e = Eigen::Matrix3d::Identity();
+  bool determined = true;   // e1 is known: given, or PCA separates lambda1 from lambda2
+  bool from_world = false;  // the world axes stand in for undetermined PCA axes
+};
+
+// Inputs and §2: given axes normalised (checked by check_inputs), else PCA of
+// `points`, with the world axes standing in when PCA does not determine e1
+// (N <= 1, or lambda1 - lambda2 <= 1e-9 lambda1).
+ObjectFrame object_axes(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
+  ObjectFrame frame;
+  if (problem.axes) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d e = problem.axes->col(k);
+      frame.e.col(k) = e / e.norm();
+    }
+    return frame;
   }
   const Eigen::Index n = points.cols();
   if (n >= 2) {
@@ -89,32 +150,144 @@ Axes object_axes(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
     if (lambda(2) - lambda(1) > kPcaEps * lambda(2)) {
       const Eigen::Vector3d e1 = eig.eigenvectors().col(2).normalized();
       const Eigen::Vector3d e2 = eig.eigenvectors().col(1).normalized();
-      axes.e.col(0) = e1;
-      axes.e.col(1) = e2;
-      axes.e.col(2) = e1.cross(e2);
-      return axes;
+      frame.e.col(0) = e1;
+      frame.e.col(1) = e2;
+      frame.e.col(2) = e1.cross(e2);
+      return frame;
     }
   }
-  axes.e.setIdentity();
-  axes.determined = false;
-  axes.from_world = true;
-  return axes;
+  frame.e.setIdentity();
+  frame.determined = false;
+  frame.from_world = true;
+  return frame;
 }
 
-// Mean and population standard deviation of eq. 9 over the rays [deg].
-std::optional<AngularErrorStats> angular_error(const Eigen::Matrix3Xd& rays,
-                                               const Eigen::Vector3d& view_from_c) {
-  const Eigen::Index n = rays.cols();
-  if (n == 0) {
+// Inputs: C (given, or the mean of `points`) and the axes, from the usable
+// supervoxels' positions `points` (3 x N, N >= 1 unless C is given).
+ObjectFrame object_frame(const ViewProblem& problem, const Eigen::Matrix3Xd& points) {
+  ObjectFrame frame = object_axes(problem, points);
+  frame.c = problem.centroid ? *problem.centroid : Eigen::Vector3d(points.rowwise().mean());
+  return frame;
+}
+
+// ---------------------------------------------------------------------------
+// §1: normals-to-sphere rays (eq. 3).
+
+// The supervoxels inside the sphere and their rays u_n = s_n - C.
+struct NormalRays {
+  Eigen::Matrix3Xd v;  // v_n of the supervoxels kept
+  Eigen::Matrix3Xd u;  // s_n - C
+  [[nodiscard]] Eigen::Index size() const { return v.cols(); }
+};
+
+// §1: s_n is where v_n + t p_n, t > 0, leaves the sphere; supervoxels at or
+// outside the sphere (|v_n - C| >= R) have no ray and are skipped.
+NormalRays normals_to_sphere_rays(const Supervoxels& s, const Eigen::Vector3d& c, double r) {
+  NormalRays rays;
+  rays.v.resize(3, s.size());
+  rays.u.resize(3, s.size());
+  Eigen::Index n = 0;
+  for (Eigen::Index k = 0; k < s.size(); ++k) {
+    if (!((s.v.col(k) - c).norm() < r)) {
+      continue;
+    }
+    rays.v.col(n) = s.v.col(k);
+    rays.u.col(n) = sphere_exit(c, r, s.v.col(k), s.p.col(k)) - c;
+    ++n;
+  }
+  rays.v.conservativeResize(3, n);
+  rays.u.conservativeResize(3, n);
+  return rays;
+}
+
+// ---------------------------------------------------------------------------
+// §2: the initial view t0 (eqs. 4, 5) and its fallbacks.
+
+// Circular mean of angles from their sine and cosine sums; empty when degenerate.
+std::optional<double> circular_mean(double sum_sin, double sum_cos) {
+  if (std::abs(sum_sin) < kCircularMeanEps && std::abs(sum_cos) < kCircularMeanEps) {
     return std::nullopt;
   }
-  Eigen::ArrayXd err(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    err(k) = angle_between(rays.col(k), view_from_c) * kRadToDeg;
-  }
-  const double mean = err.mean();
-  return AngularErrorStats{mean, std::sqrt((err - mean).square().mean())};
+  return std::atan2(sum_sin, sum_cos);
 }
+
+// §2 `spherical_mean`: circular means of the polar angle about e1 and of the
+// azimuth from e2 towards e3; empty when either is degenerate.
+std::optional<Eigen::Vector3d> spherical_mean_direction(const Eigen::Matrix3Xd& u,
+                                                        const Eigen::Matrix3d& e) {
+  const Eigen::Vector3d e1 = e.col(0), e2 = e.col(1), e3 = e.col(2);
+  double sin_theta = 0.0, cos_theta = 0.0, sin_phi = 0.0, cos_phi = 0.0;
+  for (Eigen::Index k = 0; k < u.cols(); ++k) {
+    const Eigen::Vector3d un = u.col(k);
+    const double phi = std::atan2(un.cross(e1).norm(), un.dot(e1));
+    const double theta = std::atan2(un.dot(e3), un.dot(e2));
+    sin_theta += std::sin(theta);
+    cos_theta += std::cos(theta);
+    sin_phi += std::sin(phi);
+    cos_phi += std::cos(phi);
+  }
+  const std::optional<double> theta = circular_mean(sin_theta, cos_theta);
+  const std::optional<double> phi = circular_mean(sin_phi, cos_phi);
+  if (!theta || !phi) {
+    return std::nullopt;
+  }
+  return std::cos(*phi) * e1 + std::sin(*phi) * (std::cos(*theta) * e2 + std::sin(*theta) * e3);
+}
+
+// §2 `vector_mean`: unit(sum unit(u_n)); empty when the sum is shorter than 1e-9.
+std::optional<Eigen::Vector3d> vector_mean_direction(const Eigen::Matrix3Xd& u) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (Eigen::Index k = 0; k < u.cols(); ++k) {
+    sum += u.col(k).normalized();
+  }
+  if (sum.norm() < kVectorMeanEps) {
+    return std::nullopt;
+  }
+  return sum.normalized();
+}
+
+// §2, last fallback: the direction from C to the current camera. Reaching it
+// without a camera, or with the camera at C, is a usage error.
+Eigen::Vector3d camera_direction(const std::optional<Eigen::Vector3d>& camera,
+                                 const Eigen::Vector3d& c) {
+  if (!camera) {
+    usage_error("the initial view falls back to the camera direction, but no camera is given");
+  }
+  const Eigen::Vector3d to_camera = *camera - c;
+  if (to_camera.norm() < kCameraEps) {
+    usage_error(
+        "the initial view falls back to the camera direction, but the camera is at the centroid");
+  }
+  return to_camera.normalized();
+}
+
+struct InitialViewChoice {
+  Eigen::Vector3d t0;
+  InitialViewUsed used;
+};
+
+// §2: t0 = C + R dir, dir from the chosen rule, falling back from
+// spherical_mean (needs e1 determined and N > 0) to vector_mean (N > 0) to
+// the camera.
+InitialViewChoice initial_view(const NormalRays& rays, const ObjectFrame& object,
+                               const std::optional<Eigen::Vector3d>& camera, double r,
+                               InitialView rule) {
+  const Eigen::Vector3d& c = object.c;
+  if (rule == InitialView::SphericalMean && object.determined && rays.size() > 0) {
+    if (const auto dir = spherical_mean_direction(rays.u, object.e)) {
+      return {c + r * *dir, InitialViewUsed::SphericalMean};
+    }
+  }
+  if (rays.size() > 0) {
+    if (const auto dir = vector_mean_direction(rays.u)) {
+      return {c + r * *dir, InitialViewUsed::VectorMean};
+    }
+  }
+  return {c + r * camera_direction(camera, c), InitialViewUsed::Camera};
+}
+
+// ---------------------------------------------------------------------------
+// §3: occlusion-to-sphere rays.
 
 // Occlusion-to-sphere rays d = d_nb - C in structure-of-arrays form, so that
 // one gnomonic projection of all of them is a single vectorisable loop.
@@ -123,6 +296,8 @@ struct OcclusionRays {
   [[nodiscard]] std::size_t size() const { return x.size(); }
 };
 
+// §3: for every pair (n, b) with |q_b - v_n| >= 1e-9, where the half-line from
+// v_n through q_b leaves the sphere.
 OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Matrix3Xd& v,
                              const Eigen::Matrix3Xd& q) {
   // All occluders at once per supervoxel, as Eigen arrays (vectorised).
@@ -138,7 +313,7 @@ OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Ma
   rays.z.reserve(reserve);
   const double r2 = r * r;
   for (Eigen::Index n = 0; n < v.cols(); ++n) {
-    const Eigen::Vector3d a = v.col(n) - c;  // v_n - C
+    const Eigen::Vector3d a = v.col(n) - c;    // v_n - C
     const double a_in = a.squaredNorm() - r2;  // < 0 inside the sphere
     // The half-line from v_n through q_b leaves the sphere at a + t u (from C).
     ux = qx - a.x();
@@ -162,16 +337,34 @@ OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Ma
   return rays;
 }
 
+// ---------------------------------------------------------------------------
+// §4: the iteration (eqs. 6-8).
+
+// §4 `warm_start`: C + R unit(previous_view - C) when on and given, else t0.
+Eigen::Vector3d iteration_start(const ViewProblem& problem, const EstimatorSettings& settings,
+                                const Eigen::Vector3d& c, const Eigen::Vector3d& t0) {
+  if (!settings.warm_start || !problem.previous_view) {
+    return t0;
+  }
+  const Eigen::Vector3d from_c = *problem.previous_view - c;
+  if (from_c.norm() < kCameraEps) {
+    usage_error("'previous_view' is at the centroid: no direction to warm-start from");
+  }
+  return c + settings.r_sphere * from_c.normalized();
+}
+
 // What one gnomonic projection onto the plane tangent at t tells (spec §4).
 struct Projection {
-  int in_clearance = 0;                          // points with |d_pi - t| < clearance
+  int in_clearance = 0;                            // points with |d_pi - t| < clearance
   Eigen::Vector3d push = Eigen::Vector3d::Zero();  // v
 };
 
-// Compiled for AVX-512, AVX2 and baseline x86-64, picked at run time: the
-// wider the vectors, the faster; only the reductions' summation order differs.
+// §4 projection, stop-test count and push sum in one pass. Compiled for
+// AVX-512, AVX2 and baseline x86-64, picked at run time: the wider the
+// vectors, the faster; only the reductions' summation order differs.
 template <bool kInverse>
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 Projection project_impl(const OcclusionRays& rays, const Eigen::Vector3d& t_from_c, double r,
@@ -213,6 +406,7 @@ Projection project_impl(const OcclusionRays& rays, const Eigen::Vector3d& t_from
   return p;
 }
 
+// §4: gnomonic projection of every occlusion ray onto the plane tangent at t.
 Projection project(const OcclusionRays& rays, const Eigen::Vector3d& t_from_c, double r,
                    const EstimatorSettings& s) {
   return s.push_weighting == PushWeighting::InverseDistance
@@ -242,6 +436,136 @@ Eigen::Vector3d away_from_nearest(const OcclusionRays& rays, const Eigen::Vector
   return away;
 }
 
+// §4 push direction (not normalised): v, or when |v| < 1e-12 away from the
+// nearest projected point, or when that coincides with t_i along e1 projected
+// on the tangent plane (e2 if e1 is parallel to w).
+Eigen::Vector3d push_direction(const Projection& proj, const OcclusionRays& rays,
+                               const Eigen::Vector3d& t_from_c, double r,
+                               const Eigen::Matrix3d& e) {
+  Eigen::Vector3d push = proj.push;
+  if (push.norm() < kZeroPushEps) {
+    push = away_from_nearest(rays, t_from_c, r);
+    if (push.norm() < kZeroPushEps) {
+      const Eigen::Vector3d w = t_from_c.normalized();
+      const Eigen::Vector3d e1 = e.col(0), e2 = e.col(1);
+      const Eigen::Vector3d axis = std::abs(e1.dot(w)) >= 1.0 - kParallelEps ? e2 : e1;
+      push = axis - axis.dot(w) * w;
+    }
+  }
+  return push;
+}
+
+// §4 step (eq. 7) on the tangent plane, then back to the sphere (eq. 8).
+Eigen::Vector3d step_on_sphere(const Eigen::Vector3d& t, const Eigen::Vector3d& push,
+                               const Eigen::Vector3d& c, double r, double step) {
+  const Eigen::Vector3d t_pi = t + step * push.normalized();
+  return c + r * (t_pi - c).normalized();
+}
+
+// §4 `not_converged`: the visited iterate with the fewest points inside the
+// clearance disc, ties broken by the smallest angle to t0.
+class BestIterate {
+ public:
+  explicit BestIterate(const Eigen::Vector3d& start) : t_(start) {}
+  void consider(const Eigen::Vector3d& t, int in_clearance, double angle_to_t0) {
+    if (in_clearance < count_ || (in_clearance == count_ && angle_to_t0 < angle_)) {
+      t_ = t;
+      count_ = in_clearance;
+      angle_ = angle_to_t0;
+    }
+  }
+  [[nodiscard]] const Eigen::Vector3d& t() const { return t_; }
+  [[nodiscard]] int count() const { return count_; }
+
+ private:
+  Eigen::Vector3d t_;
+  int count_ = std::numeric_limits<int>::max();
+  double angle_ = std::numeric_limits<double>::infinity();
+};
+
+// The iteration is a deterministic map of t alone: once an iterate repeats bit
+// for bit, every later one is a repeat too, none clear and none better.
+// Brent's cycle detection finds that in O(1) memory, so that a huge
+// max_iterations on a cycling scene ends with the result it would reach.
+class CycleDetector {
+ public:
+  explicit CycleDetector(const Eigen::Vector3d& start) : checkpoint_(start) {}
+  // True when t repeats an earlier iterate.
+  bool repeats(const Eigen::Vector3d& t) {
+    const bool cycling = t == checkpoint_;
+    if (++steps_since_checkpoint_ == period_) {
+      checkpoint_ = t;
+      period_ *= 2;
+      steps_since_checkpoint_ = 0;
+    }
+    return cycling;
+  }
+
+ private:
+  Eigen::Vector3d checkpoint_;
+  long steps_since_checkpoint_ = 0;
+  long period_ = 1;
+};
+
+struct IterationResult {
+  Eigen::Vector3d tf;
+  ViewStatus status;
+  int iterations;
+  int clearance_points;
+};
+
+// §4: from `start`, project, stop when clear, else push, step and go back to
+// the sphere, for at most max_iterations steps. Appends every visited iterate
+// to `path` when given.
+IterationResult iterate(const OcclusionRays& occ, const Eigen::Vector3d& start,
+                        const Eigen::Vector3d& t0, const ObjectFrame& object,
+                        const EstimatorSettings& settings, std::vector<Eigen::Vector3d>* path) {
+  const Eigen::Vector3d& c = object.c;
+  const double r = settings.r_sphere;
+  const Eigen::Vector3d t0_from_c = t0 - c;
+  Eigen::Vector3d t = start;
+  BestIterate best(start);
+  CycleDetector cycle(start);
+  bool cycling = false;
+  for (int i = 0;; ++i) {
+    if (cycling) {
+      return {best.t(), ViewStatus::NotConverged, settings.max_iterations, best.count()};
+    }
+    if (path) path->push_back(t);
+    const Eigen::Vector3d t_from_c = t - c;
+    const Projection proj = project(occ, t_from_c, r, settings);
+    if (proj.in_clearance == 0) {
+      return {t, ViewStatus::Converged, i, 0};
+    }
+    best.consider(t, proj.in_clearance, angle_between(t_from_c, t0_from_c));
+    if (i == settings.max_iterations) {
+      return {best.t(), ViewStatus::NotConverged, i, best.count()};
+    }
+    const Eigen::Vector3d push = push_direction(proj, occ, t_from_c, r, object.e);
+    t = step_on_sphere(t, push, c, r, settings.step);
+    cycling = cycle.repeats(t);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// §6: angular error (eq. 9).
+
+// Mean and population standard deviation of eq. 9 over the rays [deg]; empty
+// when there is no ray.
+std::optional<AngularErrorStats> angular_error(const Eigen::Matrix3Xd& u,
+                                               const Eigen::Vector3d& view_from_c) {
+  const Eigen::Index n = u.cols();
+  if (n == 0) {
+    return std::nullopt;
+  }
+  Eigen::ArrayXd err(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    err(k) = angle_between(u.col(k), view_from_c) * kRadToDeg;
+  }
+  const double mean = err.mean();
+  return AngularErrorStats{mean, std::sqrt((err - mean).square().mean())};
+}
+
 }  // namespace
 
 double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -258,291 +582,59 @@ Eigen::Vector3d sphere_exit(const Eigen::Vector3d& centre, double radius,
   return origin + t * u;
 }
 
-void validate(const EstimatorSettings& s) {
-  require_positive("r_seed", s.r_seed);
-  require_positive("r_sphere", s.r_sphere);
-  require_positive("clearance", s.clearance);
-  require_positive("push_radius", s.push_radius);
-  require_positive("step", s.step);
-  if (s.max_iterations < 0) {
-    usage_error("parameter 'max_iterations' must be a non-negative integer, got " +
-                std::to_string(s.max_iterations));
-  }
-}
-
-EstimatorSettings EstimatorParams::resolve() const {
-  EstimatorSettings s;
-  s.r_seed = r_seed.value_or(s.r_seed);
-  s.r_sphere = r_sphere.value_or(s.r_sphere);
-  switch (preset) {
-    case Preset::Paper:
-      s.clearance = s.r_seed;
-      s.push_radius = s.r_sphere;
-      s.step = s.r_seed;
-      s.max_iterations = 500;
-      break;
-    case Preset::AuthorsCode:
-      s.clearance = 2.0 * s.r_seed;
-      s.push_radius = s.r_sphere;
-      s.step = s.r_seed / 2.0;
-      s.max_iterations = 50;
-      break;
-  }
-  s.initial_view = initial_view.value_or(s.initial_view);
-  s.clearance = clearance.value_or(s.clearance);
-  s.push_radius = push_radius.value_or(s.push_radius);
-  s.push_weighting = push_weighting.value_or(s.push_weighting);
-  s.step = step.value_or(s.step);
-  s.max_iterations = max_iterations.value_or(s.max_iterations);
-  s.warm_start = warm_start.value_or(s.warm_start);
-  validate(s);
-  return s;
-}
-
 ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& settings,
                            const EstimateOptions& options) {
-  validate(settings);
-  if (problem.positions.cols() != problem.normals.cols()) {
-    usage_error("supervoxel positions (" + std::to_string(problem.positions.cols()) +
-                ") and normals (" + std::to_string(problem.normals.cols()) +
-                ") differ in number");
-  }
-  if (problem.centroid) require_finite("centroid", *problem.centroid);
-  if (problem.camera) require_finite("camera", *problem.camera);
-  if (problem.previous_view) require_finite("previous_view", *problem.previous_view);
-
+  check_inputs(problem, settings);
   const double r = settings.r_sphere;
+
+  // Inputs, §7: C and the axes describe the whole object, so they come from
+  // every usable supervoxel, also those §1 then skips for lying at or outside
+  // the sphere (which is judged against this C).
+  const Supervoxels supervoxels = usable_supervoxels(problem);
+  if (!problem.centroid && supervoxels.size() == 0) {
+    return no_supervoxels(problem);
+  }
+  const ObjectFrame object = object_frame(problem, supervoxels.v);
+  const Eigen::Vector3d& c = object.c;
   ViewEstimate est;
-
-  // §7: drop supervoxels with non-finite data or no normal; normalise normals.
-  const Eigen::Index n_in = problem.positions.cols();
-  Eigen::Matrix3Xd pos(3, n_in);
-  Eigen::Matrix3Xd nrm(3, n_in);
-  Eigen::Index n_valid = 0;
-  for (Eigen::Index k = 0; k < n_in; ++k) {
-    const Eigen::Vector3d p = problem.positions.col(k);
-    const Eigen::Vector3d nv = problem.normals.col(k);
-    const double len = nv.norm();
-    if (!p.allFinite() || !nv.allFinite() || !(len >= kMinNormal)) {
-      continue;
-    }
-    pos.col(n_valid) = p;
-    nrm.col(n_valid) = nv / len;
-    ++n_valid;
-  }
-  pos.conservativeResize(3, n_valid);
-  nrm.conservativeResize(3, n_valid);
-
-  if (!problem.centroid && n_valid == 0) {
-    usage_error("no usable supervoxel and no centroid given");
-  }
-  const Eigen::Vector3d c = problem.centroid ? *problem.centroid : Eigen::Vector3d(pos.rowwise().mean());
   est.centroid = c;
+  est.axes = object.e;
+  est.axes_from_world = object.from_world;
 
-  // §1: supervoxels at or outside the sphere are skipped.
-  Eigen::Matrix3Xd v(3, n_valid);
-  Eigen::Matrix3Xd rays(3, n_valid);  // s_n - C
-  Eigen::Index n = 0;
-  for (Eigen::Index k = 0; k < n_valid; ++k) {
-    if (!((pos.col(k) - c).norm() < r)) {
-      continue;
-    }
-    v.col(n) = pos.col(k);
-    rays.col(n) = sphere_exit(c, r, pos.col(k), nrm.col(k)) - c;
-    ++n;
-  }
-  v.conservativeResize(3, n);
-  rays.conservativeResize(3, n);
-  est.skipped_supervoxels = static_cast<int>(n_in - n);
-
-  const Axes axes = object_axes(problem, v);
-  est.axes = axes.e;
-  est.axes_from_world = axes.from_world;
-  const Eigen::Vector3d e1 = axes.e.col(0), e2 = axes.e.col(1), e3 = axes.e.col(2);
+  // §1: normals-to-sphere rays.
+  const NormalRays rays = normals_to_sphere_rays(supervoxels, c, r);
+  est.skipped_supervoxels = static_cast<int>(problem.positions.cols() - rays.size());
 
   // §2: initial view t0.
-  std::optional<Eigen::Vector3d> dir;
-  if (settings.initial_view == InitialView::SphericalMean && axes.determined && n > 0) {
-    double sin_theta = 0.0, cos_theta = 0.0, sin_phi = 0.0, cos_phi = 0.0;
-    for (Eigen::Index k = 0; k < n; ++k) {
-      const Eigen::Vector3d u = rays.col(k);
-      const double phi = std::atan2(u.cross(e1).norm(), u.dot(e1));
-      const double theta = std::atan2(u.dot(e3), u.dot(e2));
-      sin_theta += std::sin(theta);
-      cos_theta += std::cos(theta);
-      sin_phi += std::sin(phi);
-      cos_phi += std::cos(phi);
-    }
-    const std::optional<double> theta = circular_mean(sin_theta, cos_theta);
-    const std::optional<double> phi = circular_mean(sin_phi, cos_phi);
-    if (theta && phi) {
-      dir = std::cos(*phi) * e1 +
-            std::sin(*phi) * (std::cos(*theta) * e2 + std::sin(*theta) * e3);
-      est.initial_view_used = InitialViewUsed::SphericalMean;
-    }
-  }
-  if (!dir && n > 0) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (Eigen::Index k = 0; k < n; ++k) {
-      sum += rays.col(k).normalized();
-    }
-    if (sum.norm() >= kVectorMeanEps) {
-      dir = sum.normalized();
-      est.initial_view_used = InitialViewUsed::VectorMean;
-    }
-  }
-  if (!dir) {
-    if (!problem.camera) {
-      usage_error("the initial view falls back to the camera direction, but no camera is given");
-    }
-    const Eigen::Vector3d to_camera = *problem.camera - c;
-    if (to_camera.norm() < kCameraEps) {
-      usage_error("the initial view falls back to the camera direction, but the camera is at the centroid");
-    }
-    dir = to_camera.normalized();
-    est.initial_view_used = InitialViewUsed::Camera;
-  }
-  est.t0 = c + r * *dir;
+  const InitialViewChoice initial =
+      initial_view(rays, object, problem.camera, r, settings.initial_view);
+  est.t0 = initial.t0;
+  est.initial_view_used = initial.used;
 
-  // §7: occluders with a non-finite coordinate are skipped.
-  Eigen::Matrix3Xd q(3, problem.occluders.cols());
-  Eigen::Index b_count = 0;
-  for (Eigen::Index k = 0; k < problem.occluders.cols(); ++k) {
-    if (problem.occluders.col(k).allFinite()) {
-      q.col(b_count++) = problem.occluders.col(k);
-    }
-  }
-  q.conservativeResize(3, b_count);
-  est.skipped_occluders = static_cast<int>(problem.occluders.cols() - b_count);
-
-  // §4: the iteration.
-  Eigen::Vector3d start = est.t0;
-  if (settings.warm_start && problem.previous_view) {
-    const Eigen::Vector3d from_c = *problem.previous_view - c;
-    if (from_c.norm() < kCameraEps) {
-      usage_error("'previous_view' is at the centroid: no direction to warm-start from");
-    }
-    start = c + r * from_c.normalized();
-  }
-
-  if (b_count == 0) {
+  // §3, §4: occlusion rays and the iteration.
+  const Eigen::Matrix3Xd q = usable_occluders(problem.occluders);
+  est.skipped_occluders = static_cast<int>(problem.occluders.cols() - q.cols());
+  const Eigen::Vector3d start = iteration_start(problem, settings, c, est.t0);
+  if (q.cols() == 0) {
     est.status = ViewStatus::NoOccluders;
     est.tf = est.t0;
     if (options.record_path) est.path.push_back(est.t0);
   } else {
-    const OcclusionRays occ = occlusion_rays(c, r, v, q);
+    const OcclusionRays occ = occlusion_rays(c, r, rays.v, q);
     est.occlusion_points = static_cast<int>(occ.size());
-    const Eigen::Vector3d t0_from_c = est.t0 - c;
-
-    Eigen::Vector3d t = start;
-    Eigen::Vector3d best = start;
-    int best_count = std::numeric_limits<int>::max();
-    double best_angle = std::numeric_limits<double>::infinity();
-    // The iteration is a deterministic map of t alone: once an iterate repeats
-    // bit for bit, every later one is a repeat too, none clear and none better.
-    // Brent's cycle detection finds that in O(1) memory, so that a huge
-    // max_iterations on a cycling scene ends with the result it would reach.
-    Eigen::Vector3d checkpoint = start;
-    long steps_since_checkpoint = 0;
-    long checkpoint_period = 1;
-    bool cycling = false;
-    for (int i = 0;; ++i) {
-      const Eigen::Vector3d t_from_c = t - c;
-      if (cycling) {
-        est.status = ViewStatus::NotConverged;
-        est.tf = best;
-        est.iterations = settings.max_iterations;
-        est.clearance_points = best_count;
-        break;
-      }
-      if (options.record_path) est.path.push_back(t);
-      const Projection proj = project(occ, t_from_c, r, settings);
-      if (proj.in_clearance == 0) {
-        est.status = ViewStatus::Converged;
-        est.tf = t;
-        est.iterations = i;
-        est.clearance_points = 0;
-        break;
-      }
-      const double angle = angle_between(t_from_c, t0_from_c);
-      if (proj.in_clearance < best_count ||
-          (proj.in_clearance == best_count && angle < best_angle)) {
-        best = t;
-        best_count = proj.in_clearance;
-        best_angle = angle;
-      }
-      if (i == settings.max_iterations) {
-        est.status = ViewStatus::NotConverged;
-        est.tf = best;
-        est.iterations = i;
-        est.clearance_points = best_count;
-        break;
-      }
-      Eigen::Vector3d push = proj.push;
-      if (push.norm() < kZeroPushEps) {
-        push = away_from_nearest(occ, t_from_c, r);
-        if (push.norm() < kZeroPushEps) {
-          const Eigen::Vector3d w = t_from_c.normalized();
-          const Eigen::Vector3d axis = std::abs(e1.dot(w)) >= 1.0 - kParallelEps ? e2 : e1;
-          push = axis - axis.dot(w) * w;
-        }
-      }
-      const Eigen::Vector3d t_pi = t + settings.step * push.normalized();
-      t = c + r * (t_pi - c).normalized();
-      cycling = t == checkpoint;
-      if (++steps_since_checkpoint == checkpoint_period) {
-        checkpoint = t;
-        checkpoint_period *= 2;
-        steps_since_checkpoint = 0;
-      }
-    }
+    const IterationResult it =
+        iterate(occ, start, est.t0, object, settings, options.record_path ? &est.path : nullptr);
+    est.tf = it.tf;
+    est.status = it.status;
+    est.iterations = it.iterations;
+    est.clearance_points = it.clearance_points;
   }
 
-  est.error_t0 = angular_error(rays, est.t0 - c);
-  est.error_tf = angular_error(rays, est.tf - c);
+  // §6: angular errors.
+  est.error_t0 = angular_error(rays.u, est.t0 - c);
+  est.error_tf = angular_error(rays.u, est.tf - c);
   est.tf_to_t0_deg = angle_between(est.tf - c, est.t0 - c) * kRadToDeg;
   return est;
-}
-
-const char* to_string(InitialView v) {
-  return v == InitialView::SphericalMean ? "spherical_mean" : "vector_mean";
-}
-const char* to_string(PushWeighting v) {
-  return v == PushWeighting::Sum ? "sum" : "inverse_distance";
-}
-const char* to_string(Preset v) { return v == Preset::Paper ? "paper" : "authors_code"; }
-const char* to_string(ViewStatus v) {
-  switch (v) {
-    case ViewStatus::Converged: return "converged";
-    case ViewStatus::NotConverged: return "not_converged";
-    case ViewStatus::NoOccluders: return "no_occluders";
-    case ViewStatus::NoSupervoxels: return "no_supervoxels";
-  }
-  return "?";
-}
-const char* to_string(InitialViewUsed v) {
-  switch (v) {
-    case InitialViewUsed::SphericalMean: return "spherical_mean";
-    case InitialViewUsed::VectorMean: return "vector_mean";
-    case InitialViewUsed::Camera: return "camera";
-  }
-  return "?";
-}
-
-std::optional<InitialView> parse_initial_view(const std::string& word) {
-  if (word == "spherical_mean") return InitialView::SphericalMean;
-  if (word == "vector_mean") return InitialView::VectorMean;
-  return std::nullopt;
-}
-std::optional<PushWeighting> parse_push_weighting(const std::string& word) {
-  if (word == "sum") return PushWeighting::Sum;
-  if (word == "inverse_distance") return PushWeighting::InverseDistance;
-  return std::nullopt;
-}
-std::optional<Preset> parse_preset(const std::string& word) {
-  if (word == "paper") return Preset::Paper;
-  if (word == "authors_code") return Preset::AuthorsCode;
-  return std::nullopt;
 }
 
 }  // namespace ofv

@@ -1,4 +1,5 @@
 // The estimator against hand-computed geometry and invariants (ESTIMATOR-SPEC.md).
+#include "ofv/constants.h"
 #include "ofv/estimator.h"
 
 #include <Eigen/Geometry>
@@ -12,7 +13,7 @@ namespace ofv {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kDeg = kPi / 180.0;
 
 Eigen::Matrix3Xd cols(std::initializer_list<Eigen::Vector3d> points) {
   Eigen::Matrix3Xd m(3, static_cast<Eigen::Index>(points.size()));
@@ -153,6 +154,37 @@ TEST(Estimator, SupervoxelAtTheSphereBoundaryIsSkipped) {
   EXPECT_EQ(e.skipped_supervoxels, 1);
 }
 
+// Spec, Inputs: skipping removes a supervoxel's ray, never its part in C or
+// in the PCA. A cross longer in x than in y has C = (0, 0, 1) and e1 = x; a
+// fifth supervoxel F = (0, 2, 1) far along y moves C to the mean of the five,
+// (0, 0.4, 1), which leaves F 1.6 m away (outside R = 0.5: skipped) and the
+// other four inside (at most sqrt(0.1^2 + 0.4^2) = 0.41 m and 0.45 m). With F
+// the covariance is diag(0.02/5, 3.205/5, 0) (cov_xy = 0.1*0.4 - 0.1*0.4 = 0),
+// so e1 = +-y.
+TEST(Estimator, SkippedSupervoxelStillMovesTheCentroidAndTheAxes) {
+  ViewProblem cross;
+  cross.positions = cols({{-0.1, 0, 1}, {0.1, 0, 1}, {0, -0.05, 1}, {0, 0.05, 1}});
+  cross.normals = cols({{0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0, 0, -1}});
+  cross.occluders = cols({{0.02, 0.03, 0.6}});
+  const ViewEstimate without = estimate_view(cross, EstimatorSettings{});
+  EXPECT_EQ(without.skipped_supervoxels, 0);
+  EXPECT_TRUE(without.centroid.isApprox(Eigen::Vector3d(0, 0, 1), 1e-15));
+  EXPECT_NEAR(std::abs(without.axes.col(0).x()), 1.0, 1e-12);
+
+  ViewProblem with_far = cross;
+  with_far.positions = cols({{-0.1, 0, 1}, {0.1, 0, 1}, {0, -0.05, 1}, {0, 0.05, 1}, {0, 2, 1}});
+  with_far.normals = cols({{0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0, 0, -1}});
+  const ViewEstimate e = estimate_view(with_far, EstimatorSettings{});
+  EXPECT_EQ(e.skipped_supervoxels, 1);
+  EXPECT_EQ(e.occlusion_points, 4);  // F has no ray: 4 supervoxels x 1 occluder
+  EXPECT_NEAR((e.centroid - Eigen::Vector3d(0, 0.4, 1)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(std::abs(e.axes.col(0).y()), 1.0, 1e-12);
+  EXPECT_FALSE(e.axes_from_world);
+  EXPECT_NEAR(e.axes.col(0).cross(e.axes.col(1)).dot(e.axes.col(2)), 1.0, 1e-12);
+  // t0 lies on the sphere about the moved C.
+  EXPECT_NEAR((e.t0 - e.centroid).norm(), 0.5, 1e-12);
+}
+
 TEST(Estimator, AllSupervoxelsOutsideTheSphereFallBackToTheCamera) {
   ViewProblem p;
   p.positions = cols({{1, 0, 0}, {-1, 0, 0}});
@@ -197,12 +229,56 @@ TEST(Estimator, InvalidSupervoxelsAndOccludersAreSkippedAndCounted) {
   EXPECT_EQ(e.occlusion_points, 3);  // 3 usable supervoxels x 1 occluder
 }
 
-TEST(Estimator, NoUsableSupervoxelAndNoCentroidIsAUsageError) {
-  ViewProblem p = single_supervoxel();
-  p.normals.setZero();
-  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+TEST(Estimator, NoUsableSupervoxelAndNoCentroidIsTheNoSupervoxelsOutcome) {
   ViewProblem empty;
-  EXPECT_THROW((void)estimate_view(empty, EstimatorSettings{}), std::invalid_argument);
+  const ViewEstimate e = estimate_view(empty, EstimatorSettings{});
+  EXPECT_EQ(e.status, ViewStatus::NoSupervoxels);
+  EXPECT_STREQ(to_string(e.status), "no_supervoxels");
+  EXPECT_EQ(e.t0, Eigen::Vector3d::Zero());
+  EXPECT_EQ(e.tf, Eigen::Vector3d::Zero());
+  EXPECT_EQ(e.iterations, 0);
+  EXPECT_FALSE(e.error_t0);
+  EXPECT_FALSE(e.error_tf);
+
+  // Every supervoxel unusable by §7; the camera stays where it is.
+  ViewProblem p = patch(2, 2, 0.02);
+  p.normals.col(0).setZero();
+  p.normals(2, 1) = kNaN;
+  p.positions(0, 2) = std::numeric_limits<double>::infinity();
+  p.normals.col(3) *= 1e-13;
+  p.occluders = cols({{0, 0, 0.7}, {kNaN, 0, 0.7}});
+  p.camera = Eigen::Vector3d(0.1, 0.2, 0.3);
+  const ViewEstimate f = estimate_view(p, EstimatorSettings{}, {true});
+  EXPECT_EQ(f.status, ViewStatus::NoSupervoxels);
+  EXPECT_EQ(f.t0, *p.camera);
+  EXPECT_EQ(f.tf, *p.camera);
+  EXPECT_EQ(f.iterations, 0);
+  EXPECT_EQ(f.skipped_supervoxels, 4);
+  EXPECT_EQ(f.skipped_occluders, 1);
+  EXPECT_FALSE(f.error_t0);
+  EXPECT_FALSE(f.error_tf);
+
+  // With a given centroid there is something to look at: the §2 fallbacks apply.
+  p.centroid = Eigen::Vector3d(0, 0, 1);
+  const ViewEstimate g = estimate_view(p, EstimatorSettings{});
+  EXPECT_NE(g.status, ViewStatus::NoSupervoxels);
+  EXPECT_EQ(g.initial_view_used, InitialViewUsed::Camera);
+}
+
+TEST(Estimator, InvalidInputStillThrowsWithoutUsableSupervoxels) {
+  ViewProblem p;
+  EstimatorSettings s;
+  s.step = 0.0;
+  EXPECT_THROW((void)estimate_view(p, s), std::invalid_argument);
+  p.camera = Eigen::Vector3d(kNaN, 0, 0);
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  p.camera.reset();
+  p.axes = Eigen::Matrix3d::Zero();
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  p.axes.reset();
+  p.positions.resize(3, 1);
+  p.positions.setZero();
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
 }
 
 TEST(Estimator, NormalsAreNormalised) {
@@ -243,7 +319,13 @@ TEST(Estimator, GivenAxesMustBeFiniteAndNonZero) {
   ViewProblem p = patch(3, 2, 0.02);
   p.axes = Eigen::Matrix3d::Identity();
   p.axes->col(1).setZero();
-  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  try {
+    (void)estimate_view(p, EstimatorSettings{});
+    ADD_FAILURE() << "a zero axis was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("axis e2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("[0, 0, 0]"), std::string::npos) << e.what();
+  }
   p.axes = Eigen::Matrix3d::Identity() * 3.0;  // normalised, not an error
   EXPECT_NO_THROW((void)estimate_view(p, EstimatorSettings{}));
 }
@@ -465,8 +547,8 @@ TEST(Geometry, SphereExitFromInsideLandsOnTheSphere) {
     EXPECT_GT((s - o).dot(dir), 0.0);
     EXPECT_LT((s - o).normalized().cross(dir.normalized()).norm(), 1e-12);
   }
-  EXPECT_NEAR(angle_between({1, 0, 0}, {0, 2, 0}), 3.14159265358979323846 / 2, 1e-15);
-  EXPECT_NEAR(angle_between({1, 0, 0}, {-1, 1e-20, 0}), 3.14159265358979323846, 1e-15);
+  EXPECT_NEAR(angle_between({1, 0, 0}, {0, 2, 0}), kPi / 2, 1e-15);
+  EXPECT_NEAR(angle_between({1, 0, 0}, {-1, 1e-20, 0}), kPi, 1e-15);
 }
 
 }  // namespace

@@ -165,6 +165,10 @@ TEST(SceneJson, ResultHasEverySpecField) {
   const json k = json::parse(estimate_to_json(none).dump());
   EXPECT_TRUE(k["angular_error_deg"]["t0"]["mean"].is_null());
   EXPECT_TRUE(k["angular_error_deg"]["tf"]["std"].is_null());
+
+  const json nothing = json::parse(estimate_to_json(estimate_view(ViewProblem{}, {})).dump());
+  EXPECT_EQ(nothing["status"], "no_supervoxels");
+  EXPECT_TRUE(nothing["angular_error_deg"]["tf"]["mean"].is_null());
 }
 
 TEST(SceneJson, PrettyPrintingKeepsTheValue) {

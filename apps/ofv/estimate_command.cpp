@@ -39,7 +39,8 @@ namespace {
 
 constexpr const char* kOutputHelp = R"(
 Output: one JSON object (t0, tf, status, iterations, initial_view_used, skipped counts,
-angular_error_deg) on stdout. Exit 0 ok, 2 bad input (one line on stderr).)";
+angular_error_deg) on stdout. Exit 0 ok, 2 bad input, including a scene with no usable
+supervoxel and no centroid (one line on stderr).)";
 
 }  // namespace
 
@@ -81,6 +82,17 @@ Command add_estimate_command(CLI::App& app) {
                 estimate = estimate_view(scene.problem, scene.params.resolve(), options);
               } catch (const std::invalid_argument& e) {
                 throw std::invalid_argument(opt->scene + ": " + e.what());
+              }
+              if (estimate.status == ViewStatus::NoSupervoxels) {
+                // Spec §8: nothing to look at is the scene's fault, not a result.
+                const int n = estimate.skipped_supervoxels;
+                throw std::invalid_argument(
+                    opt->scene + ": no usable supervoxel and no centroid given (" +
+                    (n == 0 ? std::string("the scene has no supervoxels")
+                            : "none of the " + std::to_string(n) +
+                                  " supervoxels has a finite position and a finite, non-zero "
+                                  "normal") +
+                    ")");
               }
               const auto json = estimate_to_json(estimate);
               std::cout << (opt->compact ? json.dump() : to_pretty_string(json)) << '\n';

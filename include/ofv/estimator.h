@@ -44,12 +44,17 @@ enum class Preset {
   AuthorsCode,  ///< the authors' public 2020 implementation: step r_seed/2, clearance 2 r_seed, 50 iterations
 };
 
-/// \brief Outcome of the iteration.
+/// \brief Outcome of one estimate: the three of the iteration (spec §4), or
+/// that there was nothing to estimate from.
 enum class ViewStatus {
   Converged,     ///< t_f has no projected occlusion point within `clearance`
   NotConverged,  ///< max_iterations reached; t_f is the best visited iterate
   NoOccluders,   ///< no valid occluder: t_f = t0
-  NoSupervoxels,  ///< no usable supervoxel and no given centroid: no view (t0 = tf = camera)
+  /// No usable supervoxel (all skipped by spec §7) and no given centroid, so
+  /// neither C nor a view exists: t0 = tf = the camera position if given, else
+  /// zero, no angular errors. A closed loop treats it as the object lost;
+  /// `ofv estimate` as a usage error (spec §8).
+  NoSupervoxels,
 };
 
 /// \brief Which rule produced t0 after the spec's fallbacks (spec §2).
@@ -111,8 +116,11 @@ struct ViewProblem {
   Eigen::Matrix3Xd positions;  ///< 3 x N object supervoxel centroids v_n
   Eigen::Matrix3Xd normals;    ///< 3 x N supervoxel normals p_n (any length > 1e-12)
   Eigen::Matrix3Xd occluders;  ///< 3 x B occluder points q_b (may be empty)
-  std::optional<Eigen::Vector3d> centroid;       ///< C; default: mean of the valid v_n
-  std::optional<Eigen::Matrix3d> axes;           ///< columns e1, e2, e3; default: PCA of the v_n
+  /// C; default: mean of every usable v_n (spec §7), also those at or outside the sphere.
+  std::optional<Eigen::Vector3d> centroid;
+  /// Columns e1, e2, e3; default: PCA of the same v_n as C (a supervoxel skipped
+  /// by spec §1 loses its ray, never its part in C or the axes).
+  std::optional<Eigen::Matrix3d> axes;
   std::optional<Eigen::Vector3d> camera;         ///< current camera position (t0's last fallback)
   std::optional<Eigen::Vector3d> previous_view;  ///< previous t_f, used with warm_start
 };
@@ -157,13 +165,21 @@ struct EstimateOptions {
 /**
  * \brief Estimates the occlusion-free view for one frame (spec §1-§6).
  *
+ * A frame with no usable supervoxel and no given centroid is an expected
+ * outcome, not an error: status ViewStatus::NoSupervoxels, t0 = tf = the
+ * camera position if given (else zero), iterations 0, no angular errors,
+ * every supervoxel counted in skipped_supervoxels, the non-finite occluders in
+ * skipped_occluders; the other fields keep their defaults.
+ *
  * \param problem  the frame's supervoxels, occluders and optional inputs (world frame).
  * \param settings validated with validate().
  * \param options  diagnostics switches.
- * \throws std::invalid_argument on usage errors: invalid settings, a
- *         non-finite or zero-length given axis, a non-finite optional point,
- *         mismatched positions/normals, no usable supervoxel and no centroid,
- *         or the camera fallback reached without a usable camera.
+ * \throws std::invalid_argument on invalid input, with a message naming the
+ *         field and the value: invalid settings, a non-finite or zero-length
+ *         given axis, a non-finite optional point, mismatched positions and
+ *         normals, the camera fallback of t0 (spec §2) reached without a
+ *         camera or with the camera at C, or a warm start from a previous
+ *         view at C.
  */
 [[nodiscard]] ViewEstimate estimate_view(const ViewProblem& problem,
                                          const EstimatorSettings& settings,
