@@ -70,7 +70,7 @@ std::string settings_help(const std::vector<SettingDoc>& docs) {
   std::ostringstream out;
   for (const auto& d : docs) {
     out << "  " << d.name << std::string(d.name.size() < 26 ? 26 - d.name.size() : 1, ' ') << d.type
-        << ", default " << (d.default_value.empty() ? "none" : d.default_value) << (d.unit.empty() ? "" : " " + d.unit)
+        << ", default " << (d.default_value.empty() ? "none" : d.default_value) << (d.unit.empty() ? "" : " [" + d.unit + "]")
         << "\n      " << d.doc << '\n';
   }
   return out.str();

@@ -1,5 +1,6 @@
 // View selection methods besides the estimator (baselines).
 #include "ofv/view_methods.h"
+#include "ofv/constants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,7 @@ namespace ofv {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+constexpr double kRadToDeg = 180.0 / kPi;
 
 // The supervoxels the estimator would use (spec §1, §7), with their rays s_n - C.
 struct UsedSupervoxels {
@@ -92,7 +93,7 @@ const char* to_string(ViewMethod m) {
 Eigen::Matrix3Xd fibonacci_directions(int n) {
   if (n < 1) throw std::invalid_argument("candidate count must be >= 1, got " + std::to_string(n));
   Eigen::Matrix3Xd d(3, n);
-  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
   for (int k = 0; k < n; ++k) {
     const double z = 1.0 - (2.0 * k + 1.0) / n;
     const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));

@@ -1,5 +1,6 @@
 // View methods: Fibonacci candidates, view scoring, the angular error and the sampling planner.
 #include "ofv/view_methods.h"
+#include "ofv/constants.h"
 
 #include <gtest/gtest.h>
 
@@ -34,7 +35,7 @@ TEST(ViewMethods, FibonacciDirectionsCoverTheSphereEvenly) {
     }
     nearest_max = std::max(nearest_max, nearest);
   }
-  EXPECT_LT(nearest_max, 2.5 * std::sqrt(4.0 * 3.14159 / 500));  // no hole
+  EXPECT_LT(nearest_max, 2.5 * std::sqrt(4.0 * kPi / 500));  // no hole
   EXPECT_THROW((void)fibonacci_directions(0), std::invalid_argument);
 }
 
@@ -73,7 +74,7 @@ TEST(ViewMethods, AngularErrorIsTheAngleToEachRayFromTheCentroid) {
   p.positions = Eigen::Matrix3Xd::Zero(3, 2);
   p.normals.resize(3, 2);
   p.normals << 0, 1, 0, 0, 1, 0;
-  const double a = 30.0 * 3.14159265358979323846 / 180.0;
+  const double a = 30.0 * kPi / 180.0;
   const Eigen::Vector3d view(0.5 * std::sin(a), 0.0, 0.5 * std::cos(a));
   EXPECT_NEAR(mean_angular_error_deg(p, Eigen::Vector3d::Zero(), 0.5, view), 45.0, 1e-9);
   // Supervoxels at or outside the sphere are skipped (spec §1).

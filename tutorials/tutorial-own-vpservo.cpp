@@ -5,6 +5,7 @@
 //! the occlusion-free view (from ofv::estimate_view, or any target you have)
 //! lies 60 degrees around the object. FeatureSphereView moves the camera along
 //! the sphere of radius 0.5 m to it, keeping the object centred.
+#include <ofv/constants.h>
 #include <ofv/estimator.h>
 #include <ofv/servo/feature_sphere_view.h>
 
@@ -17,7 +18,7 @@
 int main() {
   // The object's centroid and the target view, in the world frame.
   const vpColVector centroid{0.0, 0.0, 0.5};
-  const double r_sphere = 0.5, angle = 60.0 * M_PI / 180.0;
+  const double r_sphere = 0.5, angle = 60.0 * ofv::kPi / 180.0;
   const vpColVector tf{r_sphere * std::sin(angle), 0.0, 0.5 - r_sphere * std::cos(angle)};
 
   // The camera starts at the world origin, looking along +z at the object.

@@ -3,8 +3,6 @@
 
 #include "ofv/estimator.h"
 
-// Only until run_command.cpp includes it itself: it calls ofv::open_source.
-#include "ofv/sources/open_source.h"
 
 #include <CLI/CLI.hpp>
 

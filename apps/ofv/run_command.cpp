@@ -5,6 +5,7 @@
 #include "ofv/loop/episode.h"
 #include "ofv/servo/robot_loop.h"
 #include "ofv/servo/target_pose.h"
+#include "ofv/sources/open_source.h"
 
 #include <visp3/core/vpConfig.h>
 #include <visp3/core/vpPoseVector.h>

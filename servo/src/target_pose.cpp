@@ -1,5 +1,6 @@
 // Target pose on the sphere, roll by least rotation.
 #include "ofv/servo/target_pose.h"
+#include "ofv/constants.h"
 
 #include <Eigen/Geometry>
 
@@ -37,7 +38,7 @@ vpHomogeneousMatrix target_pose(const Eigen::Vector3d& t, const Eigen::Vector3d&
   const Eigen::Vector3d z_des = axis.normalized();
   Eigen::Matrix3d turn;
   if (z_cur.dot(z_des) < -1.0 + 1e-12) {
-    turn = Eigen::AngleAxisd(3.14159265358979323846, wRc.col(0)).toRotationMatrix();
+    turn = Eigen::AngleAxisd(kPi, wRc.col(0)).toRotationMatrix();
   } else {
     turn = Eigen::Quaterniond::FromTwoVectors(z_cur, z_des).toRotationMatrix();
   }

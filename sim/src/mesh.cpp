@@ -1,5 +1,6 @@
 // Triangle meshes: primitives, the deformable sheet, files through Assimp.
 #include "ofv/sim/mesh.h"
+#include "ofv/constants.h"
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -13,7 +14,6 @@ namespace ofv::sim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Flips triangles whose normal points towards `inside(centroid)`, the nearest
 // interior point of a convex shape, so that every normal points outwards.

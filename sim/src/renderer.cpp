@@ -1,5 +1,6 @@
 // Embree ray casting of a scenario: RGB-D frames, labels and ground truth.
 #include "ofv/sim/renderer.h"
+#include "ofv/constants.h"
 
 #include <embree3/rtcore.h>
 
@@ -19,7 +20,7 @@ namespace ofv::sim {
 
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kDegToRad = kPi / 180.0;
 
 // A point on a mesh: triangle and barycentric coordinates (stays on the
 // surface when the mesh moves or deforms).

@@ -1,5 +1,6 @@
 // Scenario YAML (docs/scenarios.md), motion and built-in scenarios.
 #include "ofv/sim/scenario.h"
+#include "ofv/constants.h"
 
 #include "ofv/io/scene_json.h"
 
@@ -20,7 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kDegToRad = kPi / 180.0;
 
 // A YAML map read strictly: every key must be known, errors name file and key.
 class Node {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "ofv/perception/cloud.h"
+#include "ofv/constants.h"
 #include "ofv/perception/perception.h"
 
 #include "pcl_stages.h"
@@ -121,7 +122,7 @@ struct Perception::Impl {
     return plane &&
            std::abs(plane->head<3>().dot(s.centroid) + (*plane)(3)) <=
                settings.tracking.plane_distance &&
-           std::abs(plane->head<3>().dot(s.normal)) >= std::cos(M_PI / 3.0);
+           std::abs(plane->head<3>().dot(s.normal)) >= std::cos(kPi / 3.0);
   }
 
   // The stages, in the order process() runs them.

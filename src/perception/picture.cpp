@@ -1,5 +1,6 @@
 // Fig. 6-like pictures drawn with OpenCV into an 8-bit BGR image.
 #include "ofv/perception/picture.h"
+#include "ofv/constants.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -135,7 +136,7 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
   }
   back.normalize();
   const Eigen::Vector3d dir =
-      (Eigen::AngleAxisd(55.0 * M_PI / 180.0, cam_up) * back + 0.5 * cam_up).normalized();
+      (Eigen::AngleAxisd(55.0 * kPi / 180.0, cam_up) * back + 0.5 * cam_up).normalized();
   const Observer obs(c + 2.4 * r_sphere * dir, c, cam_up, 0.9 * kHeight);
 
   // The sphere as three great circles.
@@ -145,7 +146,7 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
       const Eigen::Vector3d u = a.col(k);
       const Eigen::Vector3d v = a.col((k + 1) % 3);
       for (int s = 0; s < 72; ++s) {
-        const double t0 = 2 * M_PI * s / 72, t1 = 2 * M_PI * (s + 1) / 72;
+        const double t0 = 2 * kPi * s / 72, t1 = 2 * kPi * (s + 1) / 72;
         line(image, obs, c + r_sphere * (std::cos(t0) * u + std::sin(t0) * v),
              c + r_sphere * (std::cos(t1) * u + std::sin(t1) * v), rgb(70, 70, 110));
       }

@@ -1,5 +1,6 @@
 // Back-projection, crop and voxelisation (ofv/perception/cloud.h).
 #include "ofv/perception/cloud.h"
+#include "ofv/constants.h"
 
 #include "synthetic_scene.h"
 
@@ -77,7 +78,7 @@ TEST(CloudBuilder, CropsToSphereBoxAndDepth) {
     ASSERT_LE((p.cast<double>() - sphere.centre).norm(), 0.1 + 1e-6);
   }
   // Disc of radius 0.1 m on the wall at 1 m: pi (0.1 fx)^2 pixels.
-  const double expected = M_PI * std::pow(0.1 * f.intrinsics.fx, 2);
+  const double expected = kPi * std::pow(0.1 * f.intrinsics.fx, 2);
   EXPECT_NEAR(static_cast<double>(cloud.points.size()), expected, 0.03 * expected);
 
   CropVolume box;

@@ -1,6 +1,7 @@
 // The servo side: target pose, the sphere feature against finite differences,
 // the controller in closed loop, robots, the safety filter.
 #include "ofv/servo/controller.h"
+#include "ofv/constants.h"
 #include "ofv/servo/robot.h"
 #include "ofv/servo/safety.h"
 #include "ofv/servo/target_pose.h"
@@ -16,7 +17,6 @@
 namespace ofv {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A camera at position p looking at `at` (y roughly down).
 vpHomogeneousMatrix looking_at(const Eigen::Vector3d& p, const Eigen::Vector3d& at) {

@@ -1,6 +1,7 @@
 // The simulated world: scenario files, motion, deformation, rendering against
 // analytic depth, labels, ground-truth visibility, determinism.
 #include "ofv/sim/renderer.h"
+#include "ofv/constants.h"
 
 #include <gtest/gtest.h>
 
@@ -144,7 +145,7 @@ TEST(Motion, InterpolatesPositionLinearlyAndRotationBySlerp) {
   m.waypoints = {a, b};
   EXPECT_TRUE(m.at(0.0).translation().isApprox(Eigen::Vector3d::Zero()));  // held before
   EXPECT_TRUE(m.at(2.0).translation().isApprox(Eigen::Vector3d(1, 0, 0)));
-  EXPECT_NEAR(Eigen::AngleAxisd(m.at(2.0).linear()).angle(), 3.14159265358979 / 4, 1e-9);
+  EXPECT_NEAR(Eigen::AngleAxisd(m.at(2.0).linear()).angle(), kPi / 4, 1e-9);
   EXPECT_TRUE(m.at(9.0).translation().isApprox(Eigen::Vector3d(2, 0, 0)));  // held after
 }
 
@@ -160,7 +161,7 @@ TEST(Mesh, PrimitivesAreValidAndClosedWithOutwardNormals) {
     EXPECT_GT(volume, 0.0);
   }
   EXPECT_NEAR(make_box({0.1, 0.2, 0.3}).area(), 2 * (0.02 + 0.03 + 0.06), 1e-6);
-  EXPECT_NEAR(make_sphere(0.1, 64, 32).area(), 4 * 3.14159265 * 0.01, 2e-3);
+  EXPECT_NEAR(make_sphere(0.1, 64, 32).area(), 4 * kPi * 0.01, 2e-3);
 }
 
 TEST(Mesh, DeformationKeepsTheSheetValid) {
@@ -191,7 +192,7 @@ TEST(Renderer, DepthOfAPlaneMatchesTheAnalyticValue) {
   EXPECT_EQ(f.frame.depth[f.frame.index(170, 130)], stored(0.995));
   // Tilted camera about x by 5 degrees: depth along each ray is analytic.
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
-  wMc.linear() = Eigen::AngleAxisd(5.0 * 3.14159265358979 / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  wMc.linear() = Eigen::AngleAxisd(5.0 * kPi / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
   f = r.render(wMc, 0);
   for (const auto& [u, v] : {std::pair{160, 120}, std::pair{150, 100}, std::pair{170, 140}}) {
     const Eigen::Vector3d ray_w = wMc.linear() * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);

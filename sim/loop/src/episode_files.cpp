@@ -1,5 +1,6 @@
 // The files of a simulated episode: trajectory, metrics, pictures, video, recording.
 #include "ofv/loop/episode_files.h"
+#include "ofv/constants.h"
 
 #include "ofv/loop/metrics_json.h"
 #include "ofv/sources/tum_sequence.h"
@@ -20,8 +21,6 @@ namespace ofv {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Pinhole projection of a world point for drawing; nullopt behind the camera.
 std::optional<cv::Point> project(const Eigen::Isometry3d& wMc, const CameraIntrinsics& k,
