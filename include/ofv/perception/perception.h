@@ -40,7 +40,7 @@ namespace ofv {
 /// \brief Settings of the supervoxel stage (pcl::SupervoxelClustering).
 struct SupervoxelSettings {
   double voxel_resolution = 0.008;  ///< voxel edge [m]
-  double seed_resolution = 0.02;    ///< R_seed: spacing of supervoxel seeds [m] (paper: 0.02)
+  double seed_resolution = EstimatorSettings{}.r_seed;  ///< R_seed: spacing of supervoxel seeds [m] (paper: 0.02)
   double colour_importance = 0.2;   ///< weight of colour distance in the clustering
   double spatial_importance = 0.4;  ///< weight of spatial distance
   double normal_importance = 1.0;   ///< weight of normal difference
@@ -108,7 +108,7 @@ struct PerceptionSettings {
   CloudSettings cloud;  ///< back-projection; its voxel resolution is supervoxels.voxel_resolution
   SupervoxelSettings supervoxels;
   TrackingSettings tracking;
-  double r_sphere = 0.5;     ///< R_sphere = d_pref (paper eq. 2) [m]
+  double r_sphere = EstimatorSettings{}.r_sphere;  ///< R_sphere = d_pref (paper eq. 2) [m]
   double crop_margin = 0.1;  ///< crop radius = r_sphere + crop_margin around the previous C [m]
   double max_depth = 3.0;    ///< points farther along the optical axis are dropped [m]
   /// The object's OBB (PCA of its voxels) grows by this on every side [m]:

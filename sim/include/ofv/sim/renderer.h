@@ -40,7 +40,6 @@ struct ObjectTruth {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< area-weighted surface centroid [m]
   double visible_fraction = 0.0;  ///< fraction of the surface the camera sees [0, 1]
   int occluders_in_sphere = 0;    ///< occluders with a vertex within r_sphere of the centroid
-  double mean_angular_error_deg = 0.0;  ///< eq. 9 of the camera against the visible-side normals
 };
 
 /**

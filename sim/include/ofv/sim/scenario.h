@@ -97,8 +97,8 @@ struct Scenario {
   EstimatorParams estimator;
   std::string robot = "camera";  ///< camera, viper850, afma6
   std::map<std::string, std::string> controller;  ///< law, gain, ... (read by the servo layer)
-  double r_sphere() const { return estimator.r_sphere.value_or(0.5); }
-  double r_seed() const { return estimator.r_seed.value_or(0.02); }
+  double r_sphere() const { return estimator.r_sphere.value_or(EstimatorSettings{}.r_sphere); }
+  double r_seed() const { return estimator.r_seed.value_or(EstimatorSettings{}.r_seed); }
 };
 
 /// \brief Parses a scenario from YAML text; `source` names it in errors.
