@@ -40,6 +40,9 @@ function(ofv_install_component comp)
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
     RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   foreach(dir ${arg_HEADER_DIRS})
+    if(NOT IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${arg_INCLUDE_ROOT}/${dir} AND NOT IS_DIRECTORY ${arg_INCLUDE_ROOT}/${dir})
+      message(FATAL_ERROR "ofv_install_component(${comp}): no header folder ${arg_INCLUDE_ROOT}/${dir}")
+    endif()
     get_filename_component(parent ${dir} DIRECTORY)
     install(DIRECTORY ${arg_INCLUDE_ROOT}/${dir} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/${parent}
       FILES_MATCHING PATTERN "*.h")
