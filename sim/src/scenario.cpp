@@ -6,6 +6,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -390,9 +392,61 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
   return s;
 }
 
+namespace {
+
+// Splits a ':'-separated list of paths (from the build's compile definitions).
+std::vector<fs::path> split_paths(const std::string& list) {
+  std::vector<fs::path> paths;
+  std::stringstream in(list);
+  for (std::string p; std::getline(in, p, ':');) {
+    if (!p.empty()) paths.emplace_back(p);
+  }
+  return paths;
+}
+
+// The folder of the file this code was loaded from: libofv_sim.so, or the
+// program when ofv is linked statically. Empty if unknown.
+fs::path loaded_from_dir() {
+  static const char anchor = 0;  // any object of this library
+  Dl_info info{};
+  if (dladdr(&anchor, &info) == 0 || info.dli_fname == nullptr) {
+    return {};
+  }
+  std::error_code ec;
+  const fs::path file = fs::canonical(info.dli_fname, ec);
+  return ec ? fs::path() : file.parent_path();
+}
+
+bool same_dir(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  return fs::equivalent(a, b, ec) && !ec;
+}
+
+}  // namespace
+
+// The installed prefix can move (a relocated install, the Debian package under
+// /usr, a build configured for /usr/local): the library looks next to itself
+// rather than at the path compiled in.
 std::string builtin_scenario_dir() {
-  if (const char* env = std::getenv("OFV_SCENARIO_DIR")) return env;
-  if (fs::is_directory(OFV_SOURCE_SCENARIO_DIR)) return OFV_SOURCE_SCENARIO_DIR;
+  // An explicit choice: OFV_DATA_DIR is share/ofv (OFV_SCENARIO_DIR, the
+  // scenario folder itself, is kept for older set-ups).
+  if (const char* env = std::getenv("OFV_DATA_DIR"); env != nullptr && *env != '\0') {
+    return (fs::path(env) / "scenarios").string();
+  }
+  if (const char* env = std::getenv("OFV_SCENARIO_DIR"); env != nullptr && *env != '\0') return env;
+
+  const fs::path here = loaded_from_dir();
+  if (!here.empty()) {
+    // Running from this build's output folders: the source tree's scenarios.
+    for (const fs::path& out : split_paths(OFV_BUILD_OUTPUT_DIRS)) {
+      if (same_dir(here, out) && fs::is_directory(OFV_SOURCE_SCENARIO_DIR)) return OFV_SOURCE_SCENARIO_DIR;
+    }
+    // Installed: PREFIX/lib/libofv_sim.so -> PREFIX/share/ofv/scenarios.
+    for (const fs::path& rel : split_paths(OFV_RELATIVE_SCENARIO_DIRS)) {
+      const fs::path dir = (here / rel).lexically_normal();
+      if (fs::is_directory(dir)) return dir.string();
+    }
+  }
   return OFV_INSTALLED_SCENARIO_DIR;
 }
 

@@ -116,7 +116,13 @@ struct Scenario {
 /// \brief Loads a scenario file, or a built-in scenario by name (e.g. `dvd-one-hand`).
 [[nodiscard]] Scenario load_scenario(const std::string& path_or_name);
 
-/// \brief Folder of the built-in scenarios.
+/**
+ * \brief Folder of the built-in scenarios, the first of: `$OFV_DATA_DIR/scenarios`
+ *        when that variable is set (`OFV_SCENARIO_DIR`, the folder itself, too);
+ *        the source tree's `sim/scenarios` when libofv_sim runs from its build
+ *        folder; `share/ofv/scenarios` relative to the loaded libofv_sim (so a
+ *        moved install prefix works); the configured install prefix's.
+ */
 [[nodiscard]] std::string builtin_scenario_dir();
 /// \brief Names of the built-in scenarios, sorted.
 [[nodiscard]] std::vector<std::string> builtin_scenarios();
