@@ -15,20 +15,16 @@ int main(int argc, char** argv) {
   app.set_help_all_flag("--help-all", "Print the help of every command");
 
   std::vector<Command> commands;
-#ifdef OFV_HAVE_LOOP  // built with the simulator and the servo library
+#ifdef OFV_HAVE_LOOP  // built with the simulator, the servo library and perception
   commands.push_back(add_simulate_command(app));
   commands.push_back(add_compare_command(app));
+  commands.push_back(add_run_command(app));
+  commands.push_back(add_render_command(app));
 #endif
   commands.push_back(add_estimate_command(app));
   commands.push_back(add_settings_command(app));
 #ifdef OFV_HAVE_PERCEPTION  // built with the perception front end (OFV_BUILD_PERCEPTION)
   commands.push_back(add_perceive_command(app));
-#endif
-#ifdef OFV_HAVE_RUN  // built with the perception front end and the servo library
-  commands.push_back(add_run_command(app));
-#endif
-#ifdef OFV_HAVE_SIM  // built with the simulator (OFV_BUILD_SIM)
-  commands.push_back(add_render_command(app));
 #endif
 #ifdef OFV_HAVE_RECORD  // built with the simulator and the perception sources
   commands.push_back(add_record_command(app));
