@@ -176,6 +176,7 @@ ObjectFrame object_frame(const ViewProblem& problem, const Eigen::Matrix3Xd& poi
 // The supervoxels inside the sphere and their rays u_n = s_n - C.
 struct NormalRays {
   Eigen::Matrix3Xd v;  // v_n of the supervoxels kept
+  Eigen::Matrix3Xd p;  // their unit normals p_n
   Eigen::Matrix3Xd u;  // s_n - C
   [[nodiscard]] Eigen::Index size() const { return v.cols(); }
 };
@@ -185,6 +186,7 @@ struct NormalRays {
 NormalRays normals_to_sphere_rays(const Supervoxels& s, const Eigen::Vector3d& c, double r) {
   NormalRays rays;
   rays.v.resize(3, s.size());
+  rays.p.resize(3, s.size());
   rays.u.resize(3, s.size());
   Eigen::Index n = 0;
   for (Eigen::Index k = 0; k < s.size(); ++k) {
@@ -192,10 +194,12 @@ NormalRays normals_to_sphere_rays(const Supervoxels& s, const Eigen::Vector3d& c
       continue;
     }
     rays.v.col(n) = s.v.col(k);
+    rays.p.col(n) = s.p.col(k);
     rays.u.col(n) = sphere_exit(c, r, s.v.col(k), s.p.col(k)) - c;
     ++n;
   }
   rays.v.conservativeResize(3, n);
+  rays.p.conservativeResize(3, n);
   rays.u.conservativeResize(3, n);
   return rays;
 }
@@ -635,6 +639,11 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   est.error_tf = angular_error(rays.u, est.tf - c);
   est.tf_to_t0_deg = angle_between(est.tf - c, est.t0 - c) * kRadToDeg;
   return est;
+}
+
+UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere) {
+  const NormalRays rays = normals_to_sphere_rays(usable_supervoxels(problem), centroid, r_sphere);
+  return {rays.v, rays.p, rays.u, usable_occluders(problem.occluders)};
 }
 
 }  // namespace ofv

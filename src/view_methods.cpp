@@ -12,69 +12,35 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / kPi;
 
-// The supervoxels the estimator would use (spec §1, §7), with their rays s_n - C.
-struct UsedSupervoxels {
-  Eigen::Matrix3Xd v, normal, ray;
-};
-
-UsedSupervoxels used_supervoxels(const ViewProblem& p, const Eigen::Vector3d& c, double r) {
-  UsedSupervoxels u;
-  const Eigen::Index n = p.positions.cols();
-  u.v.resize(3, n);
-  u.normal.resize(3, n);
-  u.ray.resize(3, n);
-  Eigen::Index k = 0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d v = p.positions.col(i);
-    const Eigen::Vector3d nv = p.normals.col(i);
-    if (!v.allFinite() || !nv.allFinite() || !(nv.norm() >= 1e-12) || !((v - c).norm() < r)) {
-      continue;
-    }
-    u.v.col(k) = v;
-    u.normal.col(k) = nv.normalized();
-    u.ray.col(k) = sphere_exit(c, r, v, nv) - c;
-    ++k;
-  }
-  u.v.conservativeResize(3, k);
-  u.normal.conservativeResize(3, k);
-  u.ray.conservativeResize(3, k);
-  return u;
+// Eq. 9 averaged over the usable rays [deg]; 0 without any.
+double mean_error_deg(const UsableInput& u, const Eigen::Vector3d& c, const Eigen::Vector3d& view) {
+  double error = 0.0;
+  for (Eigen::Index i = 0; i < u.rays.cols(); ++i) error += angle_between(u.rays.col(i), view - c);
+  return u.rays.cols() > 0 ? error / static_cast<double>(u.rays.cols()) * kRadToDeg : 0.0;
 }
 
-Eigen::Matrix3Xd finite_occluders(const ViewProblem& p) {
-  Eigen::Matrix3Xd q(3, p.occluders.cols());
-  Eigen::Index k = 0;
-  for (Eigen::Index b = 0; b < p.occluders.cols(); ++b) {
-    if (p.occluders.col(b).allFinite()) q.col(k++) = p.occluders.col(b);
-  }
-  q.conservativeResize(3, k);
-  return q;
-}
-
-ScoredView score(const UsedSupervoxels& u, const Eigen::Matrix3Xd& q, const Eigen::Vector3d& c,
+ScoredView score(const UsableInput& u, const Eigen::Vector3d& c,
                  const Eigen::Vector3d& view, double rho) {
   ScoredView s;
   s.view = view;
-  const Eigen::Index n = u.v.cols();
+  const Eigen::Index n = u.positions.cols();
   if (n == 0) return s;
   const double rho2 = rho * rho;
   int seen = 0;
-  double error = 0.0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    error += angle_between(u.ray.col(i), view - c);
-    const Eigen::Vector3d seg = view - u.v.col(i);
-    if (u.normal.col(i).dot(seg) <= 0.0) continue;
+    const Eigen::Vector3d seg = view - u.positions.col(i);
+    if (u.normals.col(i).dot(seg) <= 0.0) continue;
     const double len2 = seg.squaredNorm();
     bool blocked = false;
-    for (Eigen::Index b = 0; b < q.cols() && !blocked; ++b) {
-      const Eigen::Vector3d rel = q.col(b) - u.v.col(i);
+    for (Eigen::Index b = 0; b < u.occluders.cols() && !blocked; ++b) {
+      const Eigen::Vector3d rel = u.occluders.col(b) - u.positions.col(i);
       const double t = std::clamp(rel.dot(seg) / len2, 0.0, 1.0);
       blocked = (rel - t * seg).squaredNorm() < rho2;
     }
     seen += blocked ? 0 : 1;
   }
   s.visible_fraction = static_cast<double>(seen) / static_cast<double>(n);
-  s.mean_error_deg = error / static_cast<double>(n) * kRadToDeg;
+  s.mean_error_deg = mean_error_deg(u, c, view);
   return s;
 }
 
@@ -105,16 +71,12 @@ Eigen::Matrix3Xd fibonacci_directions(int n) {
 
 ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
                       const Eigen::Vector3d& view, double occluder_radius) {
-  return score(used_supervoxels(problem, centroid, r_sphere), finite_occluders(problem), centroid,
-               view, occluder_radius);
+  return score(usable_input(problem, centroid, r_sphere), centroid, view, occluder_radius);
 }
 
 double mean_angular_error_deg(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
                               const Eigen::Vector3d& view) {
-  const UsedSupervoxels u = used_supervoxels(problem, centroid, r_sphere);
-  double error = 0.0;
-  for (Eigen::Index i = 0; i < u.ray.cols(); ++i) error += angle_between(u.ray.col(i), view - centroid);
-  return u.ray.cols() > 0 ? error / static_cast<double>(u.ray.cols()) * kRadToDeg : 0.0;
+  return mean_error_deg(usable_input(problem, centroid, r_sphere), centroid, view);
 }
 
 ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
@@ -122,14 +84,13 @@ ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& c
   if (!(sampling.occluder_radius > 0.0) || !std::isfinite(sampling.occluder_radius)) {
     throw std::invalid_argument("sampling occluder_radius must be finite and positive");
   }
-  const UsedSupervoxels u = used_supervoxels(problem, centroid, r_sphere);
-  const Eigen::Matrix3Xd q = finite_occluders(problem);
+  const UsableInput u = usable_input(problem, centroid, r_sphere);
   const Eigen::Matrix3Xd dirs = fibonacci_directions(sampling.candidates);
   ScoredView best;
   best.visible_fraction = -1.0;
   for (Eigen::Index k = 0; k < dirs.cols(); ++k) {
     const ScoredView s =
-        score(u, q, centroid, centroid + r_sphere * dirs.col(k), sampling.occluder_radius);
+        score(u, centroid, centroid + r_sphere * dirs.col(k), sampling.occluder_radius);
     if (s.visible_fraction > best.visible_fraction ||
         (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
       best = s;

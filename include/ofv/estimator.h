@@ -185,6 +185,19 @@ struct EstimateOptions {
                                          const EstimatorSettings& settings,
                                          const EstimateOptions& options = {});
 
+/// \brief What the estimator uses of a problem for a given C and R: the
+///        supervoxels of spec §7 inside the sphere (§1) and the usable occluders.
+struct UsableInput {
+  Eigen::Matrix3Xd positions;  ///< 3 x N v_n [m]
+  Eigen::Matrix3Xd normals;    ///< 3 x N unit normals p_n
+  Eigen::Matrix3Xd rays;       ///< 3 x N s_n - C: where the normal leaves the sphere, from C [m]
+  Eigen::Matrix3Xd occluders;  ///< 3 x B finite q_b [m]
+};
+
+/// \brief The supervoxels, rays and occluders the estimator would use with
+///        centroid `centroid` and radius `r_sphere` (for baselines and metrics).
+[[nodiscard]] UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere);
+
 /**
  * \brief Angle between two directions [rad], robust near 0 and pi.
  */
