@@ -38,6 +38,9 @@ Command add_estimate_command(CLI::App& app);
 /// Registers `ofv render` (a simulated frame to PNGs) on the app.
 Command add_render_command(CLI::App& app);
 
+/// Every setting of the closed loop (`ofv simulate`, `ofv run`), for their help.
+std::string episode_settings_help();
+
 /// Registers `ofv simulate` (the closed loop in simulation) on the app.
 Command add_simulate_command(CLI::App& app);
 

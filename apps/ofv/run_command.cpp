@@ -109,8 +109,8 @@ Command add_run_command(CLI::App& app) {
   sub->add_flag("--dry-run", opt->dry_run,
                 "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
   sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits. The object is picked in the first frame "
-              "(the cluster nearest the image centre); when it is lost, or a frame is stale, the robot stops.\n"
-              "Settings are those of 'ofv simulate --help'.");
+              "(the cluster nearest the image centre); when it is lost, or a frame is stale, the robot stops.\n\n" +
+              episode_settings_help());
 
   return {sub, [opt]() -> int {
             const bool simulated = opt->source.rfind("sim:", 0) == 0;

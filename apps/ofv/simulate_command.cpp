@@ -13,17 +13,12 @@
 
 namespace ofv::cli {
 
-namespace {
-
 namespace fs = std::filesystem;
 
-// One line per setting: `name  type, default D unit` then its doc.
-std::string settings_footer() {
+std::string episode_settings_help() {
   return "Settings (--set name=value; also in scenario files' controller section and in grids):\n" +
          settings_help(episode_settings_table().docs());
 }
-
-}  // namespace
 
 Command add_simulate_command(CLI::App& app) {
   struct Options {
@@ -59,7 +54,7 @@ Command add_simulate_command(CLI::App& app) {
   for (const auto& n : sim::builtin_scenarios()) list += (list.empty() ? "" : ", ") + n;
   sub->footer("Built-in scenarios: " + list + "\nWrites trajectory.csv, metrics.json and pictures (camera views and "
               "scene views at the start, when an occluder enters the sphere or the visibility falls below 0.9, 1 s later "
-              "and at the end; visibility.png); with --video, episode.avi.\n\n" + settings_footer());
+              "and at the end; visibility.png); with --video, episode.avi.\n\n" + episode_settings_help());
 
   return {sub, [opt]() -> int {
             EpisodeSetup setup;
