@@ -1,21 +1,17 @@
 // `ofv perceive SOURCE [--out DIR] [--pictures]`: the perception front end
-// and the estimator on every frame of a recording or device.
+// and the estimator on every frame of a recording or device. The loop is
+// ofv::perceive() and the records ofv/perception/perceive_files.h: this file
+// parses the options, calls them and prints.
 #include "commands.h"
 
 #include "ofv/estimator.h"
-#include "ofv/io/scene_json.h"
+#include "ofv/perception/perceive.h"
+#include "ofv/perception/perceive_files.h"
 #include "ofv/perception/perception.h"
-#include "ofv/perception/picture.h"
 #include "ofv/sources/open_source.h"
 #include "ofv/sources/openni2_source.h"
 
-#include <nlohmann/json.hpp>
-
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -64,26 +60,6 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t count,
   return values;
 }
 
-nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
-  return {{"valid_pixels", c.valid_pixels},
-          {"cropped_points", c.cropped_points},
-          {"voxels", c.voxels},
-          {"supervoxels", c.supervoxels},
-          {"adjacency_edges", c.adjacency_edges},
-          {"object", c.object},
-          {"object_voxels", c.object_voxels},
-          {"hidden_voxels", c.hidden_voxels},
-          {"hidden_vertices", c.hidden_vertices},
-          {"interacting", c.interacting},
-          {"occluders", c.occluders}};
-}
-
-nlohmann::ordered_json timings_json(const PerceptionTimings& t, double estimate_ms) {
-  return {{"cloud", t.cloud},       {"supervoxels", t.supervoxels}, {"adjacency", t.adjacency},
-          {"tracking", t.tracking}, {"classify", t.classify},       {"front_end", t.total},
-          {"estimate", estimate_ms}};
-}
-
 /// What the user asked for, as parsed.
 struct Options {
   std::string source;
@@ -124,43 +100,6 @@ PerceptionSettings perception_settings(const Options& opt, const EstimatorSettin
   }
   validate(ps);
   return ps;
-}
-
-/// One frame's record: {"frame", "timestamp", "status", ["message",] "problem",
-/// "estimate", "counts", "timings_ms"}; problem and estimate are null when lost.
-nlohmann::ordered_json frame_json(int index, const RgbdFrame& frame, const PerceptionResult& r,
-                                  const std::optional<Scene>& scene,
-                                  const std::optional<ViewEstimate>& estimate, double estimate_ms) {
-  nlohmann::ordered_json j;
-  j["frame"] = index;
-  j["timestamp"] = frame.timestamp;
-  j["status"] = to_string(r.status);
-  if (!r.message.empty()) {
-    j["message"] = r.message;
-  }
-  j["problem"] = scene ? scene_to_json(*scene) : nlohmann::ordered_json(nullptr);
-  j["estimate"] = estimate ? estimate_to_json(*estimate) : nlohmann::ordered_json(nullptr);
-  j["counts"] = counts_json(r.counts);
-  j["timings_ms"] = timings_json(r.timings, estimate_ms);
-  return j;
-}
-
-/// DIR/frame_NNNNNN.json and, with `picture`, DIR/frame_NNNNNN.png.
-/// \throws std::runtime_error naming the file that cannot be written.
-void write_frame(const std::string& dir, int index, const nlohmann::ordered_json& j, bool picture,
-                 const RgbdFrame& frame, const PerceptionResult& r,
-                 const std::optional<ViewEstimate>& estimate, double r_sphere) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d", index);
-  const fs::path base = fs::path(dir) / name;
-  std::ofstream file(base.string() + ".json");
-  file << j.dump(2) << '\n';
-  if (!file) {
-    throw std::runtime_error(base.string() + ".json: cannot write");
-  }
-  if (picture) {
-    save_perception_picture(base.string() + ".png", frame, r, estimate, r_sphere);
-  }
 }
 
 }  // namespace
@@ -225,47 +164,17 @@ Command add_perceive_command(CLI::App& app) {
             }
 
             try {
-              Perception perception(ps);
-              std::optional<Eigen::Vector3d> previous_view;
-              int frames = 0, lost = 0;
-              std::vector<double> front_end_ms;
-              while (opt->max_frames < 0 || frames < opt->max_frames) {
-                const std::optional<RgbdFrame> frame = source->next();
-                if (!frame) {
-                  break;
-                }
-                const PerceptionResult r = perception.process(*frame);
-                front_end_ms.push_back(r.timings.total);
-                std::optional<Scene> scene;
-                std::optional<ViewEstimate> estimate;
-                double estimate_ms = 0.0;
-                if (r.status != TrackingStatus::Lost) {
-                  scene = Scene{r.problem, params};
-                  scene->problem.previous_view = previous_view;
-                  const auto start = std::chrono::steady_clock::now();
-                  estimate = estimate_view(scene->problem, settings);
-                  estimate_ms = std::chrono::duration<double, std::milli>(
-                                    std::chrono::steady_clock::now() - start)
-                                    .count();
-                  previous_view = estimate->tf;
-                } else {
-                  ++lost;
-                }
-                const nlohmann::ordered_json j =
-                    frame_json(frames, *frame, r, scene, estimate, estimate_ms);
-                if (opt->out.empty()) {
-                  std::cout << j.dump() << '\n';
-                } else {
-                  write_frame(opt->out, frames, j, opt->pictures, *frame, r, estimate,
-                              settings.r_sphere);
-                }
-                ++frames;
-              }
-              std::sort(front_end_ms.begin(), front_end_ms.end());
-              const double median =
-                  front_end_ms.empty() ? 0.0 : front_end_ms[front_end_ms.size() / 2];
-              std::cerr << "ofv perceive: " << source->describe() << ": " << frames << " frames, "
-                        << lost << " lost, front end median " << median << " ms\n";
+              const PerceiveSummary summary = perceive(
+                  *source, ps, settings, opt->max_frames, [&](const PerceivedFrame& f) {
+                    if (opt->out.empty()) {
+                      std::cout << perceived_frame_json(f, params) << '\n';
+                    } else {
+                      write_perceived_frame(opt->out, f, params, opt->pictures, settings.r_sphere);
+                    }
+                  });
+              std::cerr << "ofv perceive: " << source->describe() << ": " << summary.frames
+                        << " frames, " << summary.lost << " lost, front end median "
+                        << summary.median_front_end_ms << " ms\n";
               return kOk;
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv perceive: " << e.what() << '\n';

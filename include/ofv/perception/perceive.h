@@ -1,0 +1,69 @@
+/**
+ * \file perceive.h
+ * \brief The front end and the estimator on every frame of a source
+ *        (`ofv perceive`): frame -> Perception::process -> estimate_view,
+ *        each view estimated with the previous one as its warm start.
+ *
+ * \code
+ * auto source = ofv::open_source("recording.oni");
+ * const ofv::PerceiveSummary s = ofv::perceive(*source, ofv::PerceptionSettings{},
+ *     ofv::EstimatorSettings{}, -1, [](const ofv::PerceivedFrame& f) {
+ *       if (f.estimate) std::cout << f.index << ": " << f.estimate->tf.transpose() << '\n';
+ *     });
+ * \endcode
+ *
+ * The records of a perceived frame (JSON text, files) are in perceive_files.h.
+ */
+#pragma once
+
+#include "ofv/estimator.h"
+#include "ofv/frame_source.h"
+#include "ofv/perception/perception.h"
+#include "ofv/rgbd_frame.h"
+
+#include <functional>
+#include <optional>
+
+namespace ofv {
+
+/// \brief One frame as perceive() saw it: what the front end found and the view estimated.
+struct PerceivedFrame {
+  long index = 0;   ///< position in the sequence, from 0
+  RgbdFrame frame;  ///< the frame as the source gave it
+  /// The front end's result. When the object is not lost, `result.problem`
+  /// is exactly the estimator's input: its `previous_view` is the t_f of
+  /// the last frame that had an estimate (none before the first).
+  PerceptionResult result;
+  /// The view estimated from `result.problem`; std::nullopt when the object is lost.
+  std::optional<ViewEstimate> estimate;
+  double estimate_ms = 0.0;  ///< wall time of estimate_view() [ms]; 0 when lost
+};
+
+/// \brief What perceive() did over the whole sequence.
+struct PerceiveSummary {
+  long frames = 0;  ///< frames read and perceived
+  long lost = 0;    ///< of those, frames in which the object was lost (no estimate)
+  /// Median of the front end's total time per frame (PerceptionTimings::total)
+  /// [ms]: the upper median, element frames / 2 of the sorted times; 0 without frames.
+  double median_front_end_ms = 0.0;
+};
+
+/**
+ * \brief Reads frames from `source` until its end (or `max_frames` frames),
+ *        runs one Perception (settings `ps`) on each and, when the object is
+ *        not lost, estimate_view() with `settings`, warm-started from the
+ *        previous estimate (`previous_view`, see PerceivedFrame::result).
+ *
+ * `observer` is called once per frame, in order, before the next frame is
+ * read; the frame it gets lives only for the call.
+ *
+ * \param max_frames stop after this many frames; negative: no limit.
+ * \throws std::invalid_argument for invalid settings or a frame whose buffers
+ *         disagree with its intrinsics; whatever `source` and `observer` throw
+ *         (std::runtime_error when a device or file fails mid-way).
+ */
+PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
+                         const EstimatorSettings& settings, long max_frames,
+                         const std::function<void(const PerceivedFrame&)>& observer);
+
+}  // namespace ofv

@@ -1,0 +1,49 @@
+// The per-frame loop of `ofv perceive` (ofv/perception/perceive.h).
+#include "ofv/perception/perceive.h"
+
+#include <algorithm>
+#include <chrono>
+#include <utility>
+#include <vector>
+
+namespace ofv {
+
+PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
+                         const EstimatorSettings& settings, long max_frames,
+                         const std::function<void(const PerceivedFrame&)>& observer) {
+  Perception perception(ps);
+  std::optional<Eigen::Vector3d> previous_view;
+  PerceiveSummary summary;
+  std::vector<double> front_end_ms;
+  while (max_frames < 0 || summary.frames < max_frames) {
+    std::optional<RgbdFrame> frame = source.next();
+    if (!frame) {
+      break;
+    }
+    PerceivedFrame f;
+    f.index = summary.frames;
+    f.frame = std::move(*frame);
+    f.result = perception.process(f.frame);
+    front_end_ms.push_back(f.result.timings.total);
+    if (f.result.status != TrackingStatus::Lost) {
+      f.result.problem.previous_view = previous_view;
+      const auto start = std::chrono::steady_clock::now();
+      f.estimate = estimate_view(f.result.problem, settings);
+      f.estimate_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count();
+      previous_view = f.estimate->tf;
+    } else {
+      ++summary.lost;
+    }
+    if (observer) {
+      observer(f);
+    }
+    ++summary.frames;
+  }
+  std::sort(front_end_ms.begin(), front_end_ms.end());
+  summary.median_front_end_ms = front_end_ms.empty() ? 0.0 : front_end_ms[front_end_ms.size() / 2];
+  return summary;
+}
+
+}  // namespace ofv
