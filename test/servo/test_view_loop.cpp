@@ -1,0 +1,135 @@
+// ViewLoop (the per-frame policy) and run_on_robot (its driver on robots):
+// statuses, the safety filter in the loop, stale frames, the stop flag.
+#include "ofv/servo/robot_loop.h"
+#include "ofv/servo/view_loop.h"
+
+#include <gtest/gtest.h>
+
+#include <deque>
+
+namespace ofv {
+namespace {
+
+// A 5 x 5 patch 0.5 m ahead of a camera at the origin, facing it; an occluder
+// cluster on the line of sight when `occluded`.
+ViewProblem patch(bool occluded) {
+  ViewProblem p;
+  p.positions.resize(3, 25);
+  p.normals.resize(3, 25);
+  for (int k = 0; k < 25; ++k) {
+    p.positions.col(k) << (k % 5 - 2) * 0.02, (k / 5 - 2) * 0.02, 0.5;
+    p.normals.col(k) << 0, 0, -1;
+  }
+  p.occluders.resize(3, occluded ? 9 : 0);
+  for (int k = 0; occluded && k < 9; ++k) p.occluders.col(k) << (k % 3 - 1) * 0.01 + 0.005, (k / 3 - 1) * 0.01, 0.3;
+  return p;
+}
+
+double speed(const vpColVector& v) { return std::hypot(v[0], v[1], v[2]); }
+
+TEST(ViewLoop, StatusesAndTheSafetyFilterInTheLoop) {
+  LoopSettings settings;
+  ViewLoop loop(settings);
+  const vpHomogeneousMatrix wMc;  // at the origin, looking along +z at the patch
+  const double dt = 1.0 / 30.0;
+  LoopStep s = loop.step(patch(false), wMc, dt, 0.0);
+  EXPECT_EQ(s.status, StepStatus::NoOccluders);
+  ASSERT_TRUE(s.target);
+  s = loop.step(patch(true), wMc, dt, 0.0);
+  EXPECT_EQ(s.status, StepStatus::Converged);
+  EXPECT_GT(s.estimate->iterations, 0);
+  // From rest the command is cut to what the acceleration limit allows.
+  EXPECT_GT(speed(s.command), settings.safety.max_linear_accel * dt);
+  EXPECT_EQ(s.safety, SafetyAction::AccelerationLimit);
+  EXPECT_LE(speed(s.velocity), 2.0 * settings.safety.max_linear_accel * dt + 1e-12);
+  // A lost object or a stale frame stops the robot at once.
+  s = loop.step(std::nullopt, wMc, dt, 0.0);
+  EXPECT_EQ(s.status, StepStatus::ObjectLost);
+  EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
+  EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+  s = loop.step(patch(true), wMc, dt, 5.0);
+  EXPECT_EQ(s.safety, SafetyAction::StaleFrame);
+  EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+  // No usable supervoxel is a lost object, not an exception.
+  ViewProblem broken = patch(true);
+  broken.normals.setZero();
+  EXPECT_EQ(loop.step(broken, wMc, dt, 0.0).status, StepStatus::ObjectLost);
+  // The static baseline never moves.
+  settings.method = ViewMethod::Static;
+  ViewLoop still(settings);
+  EXPECT_EQ(still.step(patch(true), wMc, dt, 0.0).velocity.frobeniusNorm(), 0.0);
+}
+
+TEST(ViewLoop, SettingsByNameAreValidated) {
+  LoopSettings s;
+  loop_settings_table().set(s, "max_linear_speed", "0.3");
+  EXPECT_EQ(s.controller.max_linear_speed, 0.3);
+  EXPECT_EQ(s.safety.max_linear_speed, 0.3);  // one setting, both limits
+  loop_settings_table().set(s, "workspace", "-1,-1,0,1,1,2");
+  EXPECT_TRUE(s.safety.workspace.contains(Eigen::Vector3d(0, 0, 1)));
+  for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
+           {"max_linear_speed", "inf"}, {"max_linear_speed", "1e9"}, {"gain", "0"}, {"method", "nbv"},
+           {"workspace", "1,1,1,0,0,0"}, {"workspace", "1,2,3"}, {"stale_timeout", "-1"}}) {
+    try {
+      loop_settings_table().set(s, name, value);
+      ADD_FAILURE() << name << "=" << value << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Frames with given timestamps; the problem comes from RobotLoopOptions::problem_source.
+class Timestamps : public FrameSource {
+ public:
+  explicit Timestamps(std::deque<double> t) : t_(std::move(t)) {}
+  std::optional<RgbdFrame> next() override {
+    if (t_.empty()) return std::nullopt;
+    RgbdFrame f;
+    f.timestamp = t_.front();
+    t_.pop_front();
+    return f;
+  }
+  [[nodiscard]] std::string describe() const override { return "timestamps"; }
+
+ private:
+  std::deque<double> t_;
+};
+
+TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
+  Timestamps source({0.0, 1.0 / 30, 2.0 / 30, 5.0, 5.0 + 1.0 / 30});
+  FreeFlyingCamera robot{vpHomogeneousMatrix()};
+  RobotLoopOptions options;
+  options.problem_source = [](const RgbdFrame&) { return std::optional<ViewProblem>(patch(true)); };
+  std::vector<SafetyAction> actions;
+  const RobotLoopSummary summary = run_on_robot(source, robot, LoopSettings{}, options, [&](const RobotLoopFrame& f) {
+    actions.push_back(f.step->safety);
+    EXPECT_EQ(f.perception, nullptr);
+  });
+  EXPECT_EQ(summary.frames, 5);
+  EXPECT_EQ(summary.lost, 0);
+  ASSERT_EQ(actions.size(), 5U);
+  EXPECT_FALSE(stops(actions[1]));
+  EXPECT_EQ(actions[3], SafetyAction::StaleFrame);  // 5 s after the previous frame
+  EXPECT_FALSE(stops(actions[4]));
+}
+
+TEST(RobotLoop, TheStopFlagEndsTheRunAndMaxDurationTheSource) {
+  volatile std::sig_atomic_t stop = 1;
+  Timestamps source({0.0, 0.1, 0.2});
+  FreeFlyingCamera robot{vpHomogeneousMatrix()};
+  RobotLoopOptions options;
+  options.problem_source = [](const RgbdFrame&) { return std::optional<ViewProblem>(patch(false)); };
+  options.stop = &stop;
+  RobotLoopSummary summary = run_on_robot(source, robot, LoopSettings{}, options);
+  EXPECT_EQ(summary.frames, 0);
+  EXPECT_TRUE(summary.stopped);
+  stop = 0;
+  options.max_duration = 0.15;
+  summary = run_on_robot(source, robot, LoopSettings{}, options);
+  EXPECT_EQ(summary.frames, 2);  // 0 and 0.1 s; the frame at 0.2 s is past the duration
+  EXPECT_FALSE(summary.stopped);
+}
+
+}  // namespace
+}  // namespace ofv
