@@ -79,10 +79,8 @@ struct Options {
 /// The front end's settings: the options, and the estimator's R_seed and R_sphere.
 /// \throws std::invalid_argument naming the option or setting that is invalid.
 PerceptionSettings perception_settings(const Options& opt, const EstimatorSettings& settings) {
-  PerceptionSettings ps;
-  ps.supervoxels.seed_resolution = settings.r_seed;
+  PerceptionSettings ps = ofv::perception_settings(settings);
   ps.supervoxels.voxel_resolution = opt.voxel;
-  ps.r_sphere = settings.r_sphere;
   ps.obb_margin = opt.obb_margin;
   ps.tracking.max_motion = opt.max_motion;
   ps.support_plane_occludes = !opt.no_plane_occluders;

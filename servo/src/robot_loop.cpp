@@ -7,13 +7,6 @@
 
 namespace ofv {
 
-PerceptionSettings perception_settings(const EstimatorSettings& estimator) {
-  PerceptionSettings ps;
-  ps.r_sphere = estimator.r_sphere;
-  ps.supervoxels.seed_resolution = estimator.r_seed;
-  return ps;
-}
-
 RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const LoopSettings& settings,
                               const RobotLoopOptions& options,
                               const std::function<void(const RobotLoopFrame&)>& observer) {

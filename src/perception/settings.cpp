@@ -46,6 +46,13 @@ bool positive(double x) { return std::isfinite(x) && x > 0.0; }
 
 }  // namespace
 
+PerceptionSettings perception_settings(const EstimatorSettings& estimator) {
+  PerceptionSettings ps;
+  ps.r_sphere = estimator.r_sphere;
+  ps.supervoxels.seed_resolution = estimator.r_seed;
+  return ps;
+}
+
 void validate(const PerceptionSettings& s) {
   const SupervoxelSettings& sv = s.supervoxels;
   require(positive(sv.voxel_resolution), "voxel_resolution", sv.voxel_resolution, "> 0 [m]");

@@ -207,6 +207,10 @@ struct PerceptionResult {
 /// setting is out of range (non-positive resolutions, alpha outside [1, 1.5], ...).
 void validate(const PerceptionSettings& settings);
 
+/// \brief The front end's settings for an estimator: its r_sphere and, as
+///        the supervoxel seed resolution, its r_seed; the rest default.
+[[nodiscard]] PerceptionSettings perception_settings(const EstimatorSettings& estimator);
+
 /**
  * \brief Follows one object through a sequence of RGB-D frames.
  *

@@ -19,9 +19,6 @@
 
 namespace ofv {
 
-/// \brief Perception settings for a loop: the estimator's r_sphere and seed resolution, the rest default.
-[[nodiscard]] PerceptionSettings perception_settings(const EstimatorSettings& estimator);
-
 /// \brief How run_on_robot() treats its source and robot.
 struct RobotLoopOptions {
   /// The frame's camera pose is the robot's when the frame arrives (a live
