@@ -2,6 +2,8 @@
 #include "ofv/view_methods.h"
 #include "ofv/constants.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -97,6 +99,42 @@ ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& c
     }
   }
   return best;
+}
+
+const char* to_string(NoFreeView m) {
+  return m == NoFreeView::BestIterate ? "best_iterate" : "most_visible";
+}
+
+ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
+                             const Eigen::Vector3d& current, const std::vector<Eigen::Vector3d>& others,
+                             const NoFreeViewSettings& settings) {
+  const UsableInput u = usable_input(problem, centroid, r_sphere);
+  const auto on_sphere = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    const Eigen::Vector3d d = p - centroid;
+    return d.norm() > 1e-12 ? Eigen::Vector3d(centroid + r_sphere * d.normalized()) : centroid + r_sphere * Eigen::Vector3d::UnitZ();
+  };
+  const Eigen::Vector3d here = on_sphere(current);
+  const ScoredView held = score(u, centroid, here, settings.occluder_radius);
+  ScoredView best = held;
+  const auto consider = [&](const Eigen::Vector3d& view) {
+    const ScoredView s = score(u, centroid, on_sphere(view), settings.occluder_radius);
+    if (s.visible_fraction > best.visible_fraction ||
+        (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
+      best = s;
+    }
+  };
+  // Eight neighbours: rotate `here` about two tangent axes by step_deg.
+  const Eigen::Vector3d w = (here - centroid).normalized();
+  const Eigen::Vector3d a = w.unitOrthogonal();
+  const Eigen::Vector3d b = w.cross(a);
+  const double step = settings.step_deg * kPi / 180.0;
+  for (int k = 0; k < 8; ++k) {
+    const double phi = kPi / 4.0 * k;
+    const Eigen::Vector3d tangent = std::cos(phi) * a + std::sin(phi) * b;
+    consider(centroid + r_sphere * (std::cos(step) * w + std::sin(step) * tangent));
+  }
+  for (const Eigen::Vector3d& o : others) consider(o);
+  return best.visible_fraction >= held.visible_fraction + settings.margin ? best : held;
 }
 
 }  // namespace ofv

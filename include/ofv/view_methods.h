@@ -79,4 +79,36 @@ struct ScoredView {
                                           const Eigen::Vector3d& centroid, double r_sphere,
                                           const SamplingSettings& sampling);
 
+/// \brief What the loop does when the estimator finds no occlusion-free view
+///        (status not_converged): where no free view exists, or none was found.
+enum class NoFreeView {
+  BestIterate,  ///< the spec's t_f: the visited iterate with the fewest points in the clearance disc
+  MostVisible,  ///< hold the current view unless a nearby one sees clearly more (most_visible_view)
+};
+/// \brief The word in settings and files: best_iterate, most_visible.
+[[nodiscard]] const char* to_string(NoFreeView m);
+
+/// \brief Settings of most_visible_view().
+struct NoFreeViewSettings {
+  NoFreeView mode = NoFreeView::MostVisible;
+  double step_deg = 8.0;          ///< neighbours of the current view, this far from it seen from C [deg]
+  double margin = 0.05;           ///< a view must see this much more of the object than the current one
+  double occluder_radius = 0.02;  ///< an occluder point blocks lines of sight passing closer than this [m]
+};
+
+/**
+ * \brief The graceful view without a free view: scores (score_view) the
+ *        current view, its 8 neighbours at `step_deg` around it and the
+ *        `others`, all on the sphere, and returns the one that sees the
+ *        largest fraction of the object, but the current view unless that
+ *        one sees at least `margin` more. Climbing this way the camera
+ *        moves only towards clearly better views and otherwise holds still,
+ *        never towards a gap that only an edge of the object shows through.
+ * \param current the camera's position (projected on the sphere) [m].
+ */
+[[nodiscard]] ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
+                                           double r_sphere, const Eigen::Vector3d& current,
+                                           const std::vector<Eigen::Vector3d>& others,
+                                           const NoFreeViewSettings& settings);
+
 }  // namespace ofv

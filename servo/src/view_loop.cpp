@@ -94,6 +94,66 @@ SettingsTable<LoopSettings> make_table() {
   t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",
          "while t0 is occluded, continue from the previous target (warm start) instead of re-estimating from t0"},
         [](L& l, const std::string& v) { l.target_hysteresis = parse_bool("target_hysteresis", v); });
+  t.add({"anticipation", "off | predict", to_string(d.anticipation.mode), "",
+         "off: the paper's reactive view; predict: also keep clear of where tracked occluders will be over the horizon"},
+        [](L& l, const std::string& v) {
+          l.anticipation.mode = parse_word<Anticipation>("anticipation", v,
+                                                         {{"off", Anticipation::Off}, {"predict", Anticipation::Predict}});
+        });
+  t.add({"anticipation_horizon", "number", format_number(d.anticipation.horizon), "s",
+         "anticipation=predict: how far ahead the occluders' motion is followed"},
+        [](L& l, const std::string& v) {
+          l.anticipation.horizon = parse_number("anticipation_horizon", v, 0.0, 5.0, true);
+        });
+  t.add({"anticipation_samples", "integer", std::to_string(d.anticipation.samples), "",
+         "anticipation=predict: predicted copies of a moving occluder over the horizon, 1 to 10"},
+        [](L& l, const std::string& v) {
+          l.anticipation.samples = static_cast<int>(parse_integer("anticipation_samples", v, 1, 10));
+        });
+  t.add({"anticipation_min_speed", "number", format_number(d.anticipation.min_speed), "m/s",
+         "anticipation=predict: occluders tracked slower than this are taken as still"},
+        [](L& l, const std::string& v) {
+          l.anticipation.min_speed = parse_number("anticipation_min_speed", v, 0.0, 10.0, false);
+        });
+  t.add({"track_link_distance", "number", format_number(d.tracker.link_distance), "m",
+         "occluder tracks: points closer than this are one occluder"},
+        [](L& l, const std::string& v) {
+          l.tracker.link_distance = parse_number("track_link_distance", v, 0.0, 1.0, true);
+        });
+  t.add({"track_gate", "number", format_number(d.tracker.gate), "m",
+         "occluder tracks: largest distance of an occluder's centroid from its track's prediction"},
+        [](L& l, const std::string& v) { l.tracker.gate = parse_number("track_gate", v, 0.0, 10.0, true); });
+  t.add({"track_accel_noise", "number", format_number(d.tracker.accel_noise), "m/s^2",
+         "occluder tracks: white-noise acceleration of the constant-velocity Kalman filter"},
+        [](L& l, const std::string& v) {
+          l.tracker.accel_noise = parse_number("track_accel_noise", v, 0.0, 1000.0, true);
+        });
+  t.add({"track_measurement_noise", "number", format_number(d.tracker.measurement_noise), "m",
+         "occluder tracks: standard deviation of an occluder's measured centroid"},
+        [](L& l, const std::string& v) {
+          l.tracker.measurement_noise = parse_number("track_measurement_noise", v, 0.0, 1.0, true);
+        });
+  t.add({"track_confirm_hits", "integer", std::to_string(d.tracker.confirm_hits), "",
+         "occluder tracks: frames seen before a track is used, 1 to 1000"},
+        [](L& l, const std::string& v) {
+          l.tracker.confirm_hits = static_cast<int>(parse_integer("track_confirm_hits", v, 1, 1000));
+        });
+  t.add({"track_max_misses", "integer", std::to_string(d.tracker.max_misses), "",
+         "occluder tracks: frames unseen before a track is dropped, 0 to 1000"},
+        [](L& l, const std::string& v) {
+          l.tracker.max_misses = static_cast<int>(parse_integer("track_max_misses", v, 0, 1000));
+        });
+  t.add({"no_free_view", "best_iterate | most_visible", to_string(d.no_free_view.mode), "",
+         "when the estimator finds no free view: the spec's best iterate, or hold unless a nearby view sees clearly more"},
+        [](L& l, const std::string& v) {
+          l.no_free_view.mode = parse_word<NoFreeView>(
+              "no_free_view", v, {{"best_iterate", NoFreeView::BestIterate}, {"most_visible", NoFreeView::MostVisible}});
+        });
+  t.add({"no_free_view_margin", "number", format_number(d.no_free_view.margin), "",
+         "no_free_view=most_visible: a view must see this fraction more of the object than the current one, 0 to 1"},
+        [](L& l, const std::string& v) {
+          l.no_free_view.margin = parse_number("no_free_view_margin", v, 0.0, 1.0, false);
+        });
   t.add({"max_linear_accel", "number", format_number(d.safety.max_linear_accel), "m/s^2",
          "safety filter: largest change of the linear velocity"},
         [](L& l, const std::string& v) { l.safety.max_linear_accel = parse_number("max_linear_accel", v, 0.0, 100.0, true); });
@@ -118,6 +178,8 @@ const SettingsTable<LoopSettings>& loop_settings_table() {
   return table;
 }
 
+const char* to_string(Anticipation a) { return a == Anticipation::Off ? "off" : "predict"; }
+
 const char* to_string(StepStatus status) {
   switch (status) {
     case StepStatus::Converged: return "converged";
@@ -132,7 +194,8 @@ ViewLoop::ViewLoop(const LoopSettings& settings)
     : settings_(settings),
       estimator_(settings.estimator.resolve()),
       controller_(settings.controller),
-      safety_(settings.safety) {
+      safety_(settings.safety),
+      tracker_(settings.tracker) {
   if (settings_.sampling.candidates < 1 || !(settings_.sampling.occluder_radius > 0.0)) {
     throw std::invalid_argument("sampling settings: candidates must be >= 1 and occluder_radius positive");
   }
@@ -143,39 +206,63 @@ void ViewLoop::reset() {
   previous_target_.reset();
   controller_.reset();
   safety_.reset();
+  tracker_.reset();
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& problem, const ViewEstimate& estimate) {
   const double r_sphere = estimator_.r_sphere;
-  std::optional<Eigen::Vector3d> target;
   switch (settings_.method) {
-    case ViewMethod::Estimator: target = estimate.tf; break;
-    case ViewMethod::InitialView: target = estimate.t0; break;
-    case ViewMethod::Sampling: target = sample_best_view(problem, estimate.centroid, r_sphere, settings_.sampling).view; break;
     case ViewMethod::Static: return std::nullopt;
-  }
-  if (settings_.target_hysteresis && previous_target_) {
-    if (settings_.method == ViewMethod::Estimator && estimate.iterations > 0) {
-      // t0 is occluded: continue from the previous target (the spec's warm
-      // start), which stays where it is while clear and otherwise moves to
-      // the nearest clear view. While t0 is clear, t0 is the target.
-      ViewProblem from_previous = problem;
-      from_previous.previous_view = *previous_target_;
-      EstimatorSettings warm = estimator_;
-      warm.warm_start = true;
-      const ViewEstimate kept = estimate_view(from_previous, warm);
-      if (kept.status != ViewStatus::NotConverged) target = kept.tf;
-    } else if (settings_.method == ViewMethod::Sampling) {
+    case ViewMethod::InitialView: return estimate.t0;
+    case ViewMethod::Sampling: {
+      const Eigen::Vector3d best = sample_best_view(problem, estimate.centroid, r_sphere, settings_.sampling).view;
+      if (!settings_.target_hysteresis || !previous_target_) return best;
       // Keep the previous view while it sees as much as the new best.
       const Eigen::Vector3d previous = estimate.centroid + r_sphere * (*previous_target_ - estimate.centroid).normalized();
       const double rho = settings_.sampling.occluder_radius;
-      if (score_view(problem, estimate.centroid, r_sphere, previous, rho).visible_fraction >=
-          score_view(problem, estimate.centroid, r_sphere, *target, rho).visible_fraction) {
-        target = previous;
-      }
+      return score_view(problem, estimate.centroid, r_sphere, previous, rho).visible_fraction >=
+                     score_view(problem, estimate.centroid, r_sphere, best, rho).visible_fraction
+                 ? previous
+                 : best;
+    }
+    case ViewMethod::Estimator: break;
+  }
+  ViewStatus status = estimate.status;
+  Eigen::Vector3d target = estimate.tf;
+  if (settings_.target_hysteresis && previous_target_ && estimate.iterations > 0) {
+    // t0 is occluded: continue from the previous target (the spec's warm
+    // start), which stays where it is while clear and otherwise moves to
+    // the nearest clear view. While t0 is clear, t0 is the target.
+    ViewProblem from_previous = problem;
+    from_previous.previous_view = *previous_target_;
+    EstimatorSettings warm = estimator_;
+    warm.warm_start = true;
+    const ViewEstimate kept = estimate_view(from_previous, warm);
+    if (kept.status != ViewStatus::NotConverged) {
+      status = kept.status;
+      target = kept.tf;
     }
   }
+  if (status == ViewStatus::NotConverged && settings_.no_free_view.mode == NoFreeView::MostVisible) {
+    // No free view: hold, or climb towards a view that sees clearly more.
+    std::vector<Eigen::Vector3d> others{estimate.tf, estimate.t0};
+    if (previous_target_) others.push_back(*previous_target_);
+    return most_visible_view(problem, estimate.centroid, r_sphere, *problem.camera, others, settings_.no_free_view).view;
+  }
   return target;
+}
+
+Eigen::Matrix3Xd ViewLoop::predicted(const Eigen::Vector3d& centroid) const {
+  const AnticipationSettings& a = settings_.anticipation;
+  std::vector<double> times;
+  for (int k = 1; k <= a.samples; ++k) times.push_back(a.horizon * k / a.samples);
+  const Eigen::Matrix3Xd all = predicted_occluders(tracker_.tracks(), times, a.min_speed);
+  // Only the copies inside the sphere are occluders (spec §3).
+  std::vector<Eigen::Index> inside;
+  for (Eigen::Index i = 0; i < all.cols(); ++i) {
+    if ((all.col(i) - centroid).norm() < estimator_.r_sphere) inside.push_back(i);
+  }
+  return all(Eigen::all, inside);
 }
 
 LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
@@ -188,13 +275,31 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     out.estimate = estimate_view(*problem, estimator_);
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
   }
+  if (!(std::isfinite(dt) && dt > 0.0)) tracker_.reset();  // no time base: start the tracks again
+  out.tracks = problem ? tracker_.update(problem->occluders, dt) : tracker_.coast(dt);
   if (out.estimate) {
     switch (out.estimate->status) {
       case ViewStatus::Converged: out.status = StepStatus::Converged; break;
       case ViewStatus::NotConverged: out.status = StepStatus::NotConverged; break;
       default: out.status = StepStatus::NoOccluders; break;
     }
-    out.target = choose_target(*problem, *out.estimate);
+    const ViewProblem* basis = &*problem;
+    ViewProblem ahead;
+    if (settings_.anticipation.mode == Anticipation::Predict) {
+      const Eigen::Matrix3Xd future = predicted(out.estimate->centroid);
+      if (future.cols() > 0) {
+        ahead = *problem;
+        ahead.occluders.resize(3, problem->occluders.cols() + future.cols());
+        ahead.occluders << problem->occluders, future;
+        ViewEstimate anticipated = estimate_view(ahead, estimator_);
+        if (anticipated.status != ViewStatus::NotConverged) {
+          out.predicted_occluders = future.cols();
+          out.anticipated = std::move(anticipated);
+          basis = &ahead;
+        }
+      }
+    }
+    out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate);
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
   }

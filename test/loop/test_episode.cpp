@@ -60,11 +60,30 @@ TEST(Episode, IsDeterministic) {
   }
 }
 
+TEST(Episode, LatencyDelaysEveryCommandByWholeFrames) {
+  // On the hand-on-the-ray scene the camera moves from the first frame; with
+  // a latency of 3 frames it stays still for 3 periods, then makes the moves
+  // the loop commanded 3 frames earlier.
+  const EpisodeOutcome now = run(kOnRay, {{"duration", "0.5"}});
+  const EpisodeOutcome late = run(kOnRay, {{"duration", "0.5"}, {"latency", "3"}});
+  EXPECT_GT((now.steps[1].wMc.translation() - now.steps[0].wMc.translation()).norm(), 1e-4);
+  for (int k = 1; k <= 3; ++k) {
+    EXPECT_TRUE(late.steps[static_cast<std::size_t>(k)].wMc.isApprox(late.steps[0].wMc, 0.0)) << k;
+  }
+  EXPECT_GT((late.steps[4].wMc.translation() - late.steps[3].wMc.translation()).norm(), 1e-4);
+  // The first command is the same; its move comes 3 periods later.
+  EXPECT_TRUE(late.steps[0].velocity.isApprox(now.steps[0].velocity, 1e-12));
+  EXPECT_TRUE((late.steps[4].wMc.translation() - late.steps[3].wMc.translation())
+                  .isApprox(now.steps[1].wMc.translation() - now.steps[0].wMc.translation(), 1e-9));
+}
+
 TEST(Episode, SettingsAreValidatedByName) {
   const sim::Scenario s = sim::load_scenario(kOnRay);
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
            {"method", "nbv"}, {"gain", "-1"}, {"robot", "puma"}, {"perception", "magic"},
-           {"step", "big"}, {"speed", "1"}, {"sampling_candidates", "1.5"}, {"seed", "-2"}}) {
+           {"step", "big"}, {"speed", "1"}, {"sampling_candidates", "1.5"}, {"seed", "-2"},
+           {"latency", "31"}, {"latency", "-1"}, {"anticipation", "psychic"}, {"anticipation_horizon", "0"},
+           {"no_free_view", "wander"}, {"track_gate", "inf"}}) {
     try {
       (void)resolve_episode(s, {{name, value}});
       ADD_FAILURE() << name << "=" << value << " accepted";

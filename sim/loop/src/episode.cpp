@@ -5,8 +5,10 @@
 #include "ofv/sim/live_source.h"
 #include "ofv/sim/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <stdexcept>
 
@@ -39,6 +41,9 @@ SettingsTable<EpisodeSetup> make_table() {
   t.add({"seed", "integer", std::to_string(d.seed), "",
          "the scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement"},
         [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); });
+  t.add({"latency", "integer", std::to_string(d.latency), "frames",
+         "delay between capturing a frame and applying its command (simulation), 0 to 30"},
+        [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
          "run the arm on ViSP's threaded simulator in wall-clock time (robot viper850 or afma6)"},
         [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); });
@@ -74,6 +79,12 @@ void record_step(StepRecord& rec, const LoopStep& step) {
     rec.iterations = step.estimate->iterations;
   }
   rec.target = step.target;
+  for (const OccluderTrack& t : step.tracks) {
+    if (!t.confirmed || t.points.cols() == 0) continue;
+    ++rec.tracks;
+    rec.fastest_track_speed = std::max(rec.fastest_track_speed, t.velocity.norm());
+  }
+  rec.predicted_occluders = static_cast<int>(step.predicted_occluders);
   for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = step.velocity[i];
 }
 
@@ -114,6 +125,8 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   std::optional<Perception> perception;
   if (setup.perception == PerceptionMode::Full) perception.emplace(perception_settings(loop.estimator()));
 
+  // Commands on their way to the robot, oldest first.
+  std::deque<vpColVector> in_flight(static_cast<std::size_t>(setup.latency), vpColVector(6, 0.0));
   EpisodeOutcome outcome;
   for (long k = 0; k < steps; ++k) {
     StepRecord rec;
@@ -140,8 +153,8 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     }
     rec.times.perception = seconds_since(start);
 
-    // The frame is as old as one period when its command is replaced.
-    const LoopStep step = loop.step(problem, wMc_visp, dt, dt);
+    // The frame is as old as 1 + latency periods when its command is replaced.
+    const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency));
     record_step(rec, step);
 
     outcome.steps.push_back(rec);
@@ -152,7 +165,9 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
       detail.step = &step;
       observer(rec, detail);
     }
-    if (k + 1 < steps) (void)robot->step(step.velocity, dt);
+    in_flight.push_back(step.velocity);
+    if (k + 1 < steps) (void)robot->step(in_flight.front(), dt);
+    in_flight.pop_front();
   }
   outcome.metrics = summarise(outcome.steps);
   return outcome;

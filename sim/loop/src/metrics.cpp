@@ -141,7 +141,8 @@ std::string episode_summary(const EpisodeMetrics& m) {
 
 std::string trajectory_csv_header() {
   return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,targetx,targety,targetz,status,safety,iterations,"
-         "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,"
+         "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,tracks,fastest_track_speed,"
+         "predicted_occluders,"
          "render_s,perception_s,estimate_s,control_s";
 }
 
@@ -165,7 +166,7 @@ std::string trajectory_csv_row(const StepRecord& s) {
   vec(s.target);
   out << to_string(s.status) << ',' << to_string(s.safety) << ',' << s.iterations << ',' << s.visible_fraction << ','
       << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
-      << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
+      << ',' << s.tracks << ',' << s.fastest_track_speed << ',' << s.predicted_occluders << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
       << s.times.control;
   return out.str();
 }

@@ -23,6 +23,7 @@
 #pragma once
 
 #include "ofv/estimator.h"
+#include "ofv/occluder_tracker.h"
 #include "ofv/servo/controller.h"
 #include "ofv/servo/loop_status.h"
 #include "ofv/servo/safety.h"
@@ -34,8 +35,36 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 
 #include <optional>
+#include <vector>
 
 namespace ofv {
+
+/// \brief How the loop looks ahead at moving occluders.
+enum class Anticipation {
+  Off,      ///< the paper's reactive method: the view moves once occlusion rays reach it
+  Predict,  ///< also avoid where the tracked occluders will be over the horizon
+};
+/// \brief The word in settings and files: off, predict.
+[[nodiscard]] const char* to_string(Anticipation a);
+
+/**
+ * \brief Anticipation of moving occluders (Anticipation::Predict).
+ *
+ * The occluders are tracked (ofv::OccluderTracker). Each frame, the points
+ * of every confirmed track moving faster than `min_speed` are copied to
+ * where the track's velocity takes them after horizon x k / samples,
+ * k = 1..samples; the copies inside the sphere join the frame's occluders
+ * and the estimator (unchanged, the spec's) runs on that problem. The view
+ * so keeps clear of the occluders' path over the horizon, and the camera
+ * leaves before the object is covered. When the predicted problem has no
+ * free view, the loop falls back to the frame's own (reactive) estimate.
+ */
+struct AnticipationSettings {
+  Anticipation mode = Anticipation::Predict;
+  double horizon = 0.8;    ///< how far ahead [s]
+  int samples = 2;         ///< predicted copies over the horizon
+  double min_speed = 0.15; ///< slower tracks are taken as still [m/s]
+};
 
 /// \brief Every setting of the loop; ofv::loop_settings_table() names them.
 struct LoopSettings {
@@ -55,6 +84,9 @@ struct LoopSettings {
   /// view; once t0 is clear again, t0 is the target. The sampling planner
   /// keeps its previous view while it sees as much as the new best.
   bool target_hysteresis = true;
+  AnticipationSettings anticipation;
+  TrackerSettings tracker;           ///< the occluder tracks anticipation uses
+  NoFreeViewSettings no_free_view;   ///< what to do when the estimator finds no free view
 };
 
 /**
@@ -74,6 +106,11 @@ struct LoopStep {
   vpColVector command = vpColVector(6, 0.0);   ///< the controller's twist [m/s, rad/s]
   vpColVector velocity = vpColVector(6, 0.0);  ///< after the safety filter: send this to the robot
   SafetyAction safety = SafetyAction::None;    ///< what the safety filter did
+  std::vector<OccluderTrack> tracks;  ///< the occluder tracks after this frame (confirmed or not)
+  /// The estimate on the frame's occluders plus the predicted ones
+  /// (anticipation on, something moving, a free view found).
+  std::optional<ViewEstimate> anticipated;
+  Eigen::Index predicted_occluders = 0;  ///< predicted points added to the problem
   double estimate_s = 0.0;  ///< compute time of view selection [s]
   double control_s = 0.0;   ///< compute time of controller and filter [s]
 };
@@ -93,7 +130,8 @@ class ViewLoop {
    *                  when perception lost the object. Its camera and
    *                  previous_view are set by the loop.
    * \param wMc       camera pose when the frame was taken.
-   * \param dt        period the command will be applied for [s].
+   * \param dt        time since the previous frame, and the period the command
+   *                  will be applied for [s].
    * \param frame_age how old the frame is when the command is sent [s]
    *                  (older than the stale timeout: stop).
    */
@@ -109,11 +147,13 @@ class ViewLoop {
 
  private:
   [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate);
+  [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
 
   LoopSettings settings_;
   EstimatorSettings estimator_;
   ViewController controller_;
   SafetyFilter safety_;
+  OccluderTracker tracker_;
   std::optional<Eigen::Vector3d> previous_view_, previous_target_;
 };
 

@@ -47,6 +47,11 @@ struct EpisodeSetup {
   PerceptionMode perception = PerceptionMode::Full;
   double duration = 0.0;  ///< [s]
   unsigned seed = 0;      ///< the scenario's k-th random world (sim::with_seed)
+  /// Frames between capturing a frame and applying its command: the robot
+  /// applies the command of frame k - latency during period k (zero
+  /// velocity before the first one arrives). 0: the command applies during
+  /// the period right after its frame, as if computing took no time.
+  int latency = 0;
   /// The arms on ViSP's threaded simulators (ThreadedArm), one frame period
   /// of wall-clock time per step: a real-time demo, not exactly repeatable.
   bool real_time = false;
@@ -55,7 +60,7 @@ struct EpisodeSetup {
 /**
  * \brief Every setting of an episode by name: the loop's
  *        (ofv::loop_settings_table()) and robot, perception, duration, seed,
- *        real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
 [[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();

@@ -1,0 +1,128 @@
+/**
+ * \file occluder_tracker.h
+ * \brief Occluders followed from frame to frame, with a velocity: the input
+ *        of the loop's anticipation (see ofv::predicted_occluders).
+ *
+ * Each frame the occluder points (ViewProblem::occluders, from perception or
+ * from the simulator's ground truth) are cut into clusters: single linkage,
+ * two points in one cluster when a chain of points less than `link_distance`
+ * apart joins them (a hand, an arm, a tool). Each cluster's centroid is a
+ * measurement of one track.
+ *
+ * A track is a constant-velocity Kalman filter on its position: state
+ * (position, velocity), white-noise acceleration of spectral density
+ * `accel_noise`^2 (the discrete model of Bar-Shalom, "Estimation with
+ * Applications to Tracking and Navigation", 6.2.2), position measurements
+ * with standard deviation `measurement_noise`. The position measured is
+ * the previous position moved by the translation that registers the
+ * track's previous points onto the cluster's (translation-only ICP from the
+ * predicted motion), not the cluster's centroid: the centroid also moves
+ * when the visible part of an occluder changes (an arm entering the sphere,
+ * the camera moving along a table), the registered points do not. The three axes are
+ * independent with the same noises, so one 2 x 2 covariance (position,
+ * velocity of one axis) holds for all three.
+ *
+ * Association: every track's last centroid is moved by its velocity to
+ * the frame's time; cluster and track pairs whose centroids are closer than
+ * `gate` are joined greedily, nearest first. A cluster left over starts
+ * a track (velocity 0, standard deviation `initial_speed_sigma`); a track
+ * left over coasts on its prediction and is dropped after `max_misses`
+ * frames without a cluster.
+ *
+ * Pure geometry on Eigen; deterministic (ids in order of creation).
+ *
+ * \code
+ * ofv::OccluderTracker tracker;                 // documented defaults
+ * for (each frame) {
+ *   const auto& tracks = tracker.update(problem.occluders, dt);
+ *   const Eigen::Matrix3Xd ahead = ofv::predicted_occluders(tracks, {0.2, 0.4}, 0.05);
+ * }
+ * \endcode
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace ofv {
+
+/// \brief Settings of ofv::OccluderTracker (lengths in metres, times in seconds).
+struct TrackerSettings {
+  double link_distance = 0.05;       ///< points closer than this are one cluster [m]
+  double gate = 0.1;                 ///< largest distance of a cluster's centroid from its track's prediction [m]
+  double accel_noise = 4.0;          ///< white-noise acceleration of an occluder [m/s^2]
+  double measurement_noise = 0.01;   ///< standard deviation of a cluster centroid [m]
+  double initial_speed_sigma = 1.0;  ///< velocity standard deviation of a new track [m/s]
+  int confirm_hits = 2;              ///< frames with a cluster before a track is confirmed
+  int max_misses = 3;                ///< frames without a cluster before a track is dropped
+};
+
+/// \brief Throws std::invalid_argument naming a tracker setting out of range.
+void validate(const TrackerSettings& settings);
+
+/// \brief One followed occluder (world frame).
+struct OccluderTrack {
+  int id = 0;                                          ///< unique within a tracker, in order of creation
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< filtered centroid [m]
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< filtered velocity [m/s]
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< the cluster's centroid when last seen, moved by velocity since [m]
+  /// Covariance of (position, velocity) along any one axis [m^2, m^2/s, m^2/s^2].
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  Eigen::Matrix3Xd points;  ///< the cluster's points this frame (empty when missed)
+  int hits = 0;             ///< frames with a cluster
+  int misses = 0;           ///< consecutive frames without one
+  bool confirmed = false;   ///< hits >= confirm_hits at some time
+
+  /// \brief Standard deviation of the position along one axis [m].
+  [[nodiscard]] double position_sigma() const;
+  /// \brief Standard deviation of the velocity along one axis [m/s].
+  [[nodiscard]] double speed_sigma() const;
+};
+
+/// \brief Clusters of points (single linkage at `link_distance`): column
+///        indices of each cluster, clusters in order of their first point.
+[[nodiscard]] std::vector<std::vector<int>> cluster_points(const Eigen::Matrix3Xd& points, double link_distance);
+
+/// \brief Follows occluders from frame to frame (see the file's description).
+class OccluderTracker {
+ public:
+  /// \throws std::invalid_argument naming a setting out of range.
+  explicit OccluderTracker(const TrackerSettings& settings = {});
+
+  /**
+   * \brief Takes one frame's occluder points.
+   * \param occluders 3 x B points (non-finite columns are ignored).
+   * \param dt        time since the previous frame [s] (> 0; ignored on the first frame).
+   * \return every track, confirmed or not, in id order.
+   */
+  const std::vector<OccluderTrack>& update(const Eigen::Matrix3Xd& occluders, double dt);
+
+  /// \brief A frame without an object: the tracks coast (no clusters) by dt.
+  const std::vector<OccluderTrack>& coast(double dt);
+
+  [[nodiscard]] const std::vector<OccluderTrack>& tracks() const { return tracks_; }
+  [[nodiscard]] const TrackerSettings& settings() const { return settings_; }
+  void reset();
+
+ private:
+  void predict(double dt);
+
+  TrackerSettings settings_;
+  std::vector<OccluderTrack> tracks_;
+  int next_id_ = 0;
+  bool started_ = false;
+};
+
+/**
+ * \brief Where the occluders will be: the points of every confirmed track
+ *        seen this frame and moving faster than `min_speed`, each shifted by
+ *        velocity x tau for every tau of `times`.
+ * \param times     future times [s] (> 0).
+ * \param min_speed slower tracks are taken as still [m/s].
+ * \return 3 x K points (K = 0 when nothing moves).
+ */
+[[nodiscard]] Eigen::Matrix3Xd predicted_occluders(const std::vector<OccluderTrack>& tracks,
+                                                   const std::vector<double>& times, double min_speed);
+
+}  // namespace ofv

@@ -1,0 +1,305 @@
+// Occluder clusters followed by constant-velocity Kalman filters.
+#include "ofv/occluder_tracker.h"
+
+#include "ofv/settings_table.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+namespace ofv {
+
+namespace {
+
+// Union-find with path halving.
+int find_root(std::vector<int>& parent, int i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    auto& p = parent[static_cast<std::size_t>(i)];
+    p = parent[static_cast<std::size_t>(p)];
+    i = p;
+  }
+  return i;
+}
+
+std::int64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
+  // 21 bits a coordinate: cells of a few centimetres cover kilometres.
+  constexpr std::int64_t mask = (std::int64_t{1} << 21) - 1;
+  return ((x & mask) << 42) | ((y & mask) << 21) | (z & mask);
+}
+
+void require(bool ok, const char* name, double value, const char* what) {
+  if (!ok) {
+    throw std::invalid_argument(std::string("tracker setting '") + name + "' must be " + what + ", got " +
+                                format_number(value));
+  }
+}
+
+// Translation taking `before` onto the points `cluster` of `after`: a few
+// iterations of translation-only ICP from `guess`, each matching every point
+// (at most 256, evenly spread) with its nearest neighbour in the shifted
+// `before` and moving by the median residual (per axis) of the pairs closer
+// than `trim`. The median ignores the points that appear or vanish at the
+// edge of what is seen. None when fewer than half the points (or fewer than
+// 3) find a partner: the shapes do not overlap enough to register.
+std::optional<Eigen::Vector3d> register_translation(const Eigen::Matrix3Xd& before, const Eigen::Matrix3Xd& after,
+                                                    const std::vector<int>& cluster, const Eigen::Vector3d& guess,
+                                                    double trim) {
+  const std::size_t stride = std::max<std::size_t>(1, cluster.size() / 256);
+  const double trim2 = trim * trim;
+  Eigen::Vector3d d = guess;
+  std::array<std::vector<double>, 3> residuals;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    for (auto& r : residuals) r.clear();
+    int tried = 0;
+    for (std::size_t k = 0; k < cluster.size(); k += stride, ++tried) {
+      const Eigen::Vector3d q = after.col(cluster[k]) - d;
+      Eigen::Index nearest = 0;
+      const double best = (before.colwise() - q).colwise().squaredNorm().minCoeff(&nearest);
+      if (best >= trim2) continue;
+      for (std::size_t a = 0; a < 3; ++a) residuals[a].push_back(q(static_cast<Eigen::Index>(a)) - before(static_cast<Eigen::Index>(a), nearest));
+    }
+    const auto pairs = static_cast<int>(residuals[0].size());
+    if (pairs < 3 || 2 * pairs < tried) return std::nullopt;
+    Eigen::Vector3d step;
+    for (std::size_t a = 0; a < 3; ++a) {
+      auto& r = residuals[a];
+      const auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
+      std::nth_element(r.begin(), mid, r.end());
+      step(static_cast<Eigen::Index>(a)) = *mid;
+    }
+    d += step;
+    if (step.norm() < 1e-5) break;
+  }
+  return d;
+}
+
+}  // namespace
+
+void validate(const TrackerSettings& s) {
+  require(std::isfinite(s.link_distance) && s.link_distance > 0.0 && s.link_distance <= 1.0, "link_distance",
+          s.link_distance, "in (0, 1] m");
+  require(std::isfinite(s.gate) && s.gate > 0.0 && s.gate <= 10.0, "gate", s.gate, "in (0, 10] m");
+  require(std::isfinite(s.accel_noise) && s.accel_noise > 0.0 && s.accel_noise <= 1000.0, "accel_noise",
+          s.accel_noise, "in (0, 1000] m/s^2");
+  require(std::isfinite(s.measurement_noise) && s.measurement_noise > 0.0 && s.measurement_noise <= 1.0,
+          "measurement_noise", s.measurement_noise, "in (0, 1] m");
+  require(std::isfinite(s.initial_speed_sigma) && s.initial_speed_sigma > 0.0 && s.initial_speed_sigma <= 100.0,
+          "initial_speed_sigma", s.initial_speed_sigma, "in (0, 100] m/s");
+  require(s.confirm_hits >= 1 && s.confirm_hits <= 1000, "confirm_hits", s.confirm_hits, "in [1, 1000]");
+  require(s.max_misses >= 0 && s.max_misses <= 1000, "max_misses", s.max_misses, "in [0, 1000]");
+}
+
+double OccluderTrack::position_sigma() const { return std::sqrt(std::max(0.0, covariance(0, 0))); }
+double OccluderTrack::speed_sigma() const { return std::sqrt(std::max(0.0, covariance(1, 1))); }
+
+std::vector<std::vector<int>> cluster_points(const Eigen::Matrix3Xd& points, double link_distance) {
+  const int n = static_cast<int>(points.cols());
+  std::vector<int> parent(static_cast<std::size_t>(n));
+  std::iota(parent.begin(), parent.end(), 0);
+  // Hash grid of cell edge link_distance: linked points are in neighbouring cells.
+  std::unordered_map<std::int64_t, std::vector<int>> grid;
+  std::vector<std::array<std::int64_t, 3>> cell(static_cast<std::size_t>(n));
+  std::vector<char> finite(static_cast<std::size_t>(n), 0);
+  for (int i = 0; i < n; ++i) {
+    if (!points.col(i).allFinite()) continue;
+    finite[static_cast<std::size_t>(i)] = 1;
+    for (int a = 0; a < 3; ++a) {
+      cell[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] =
+          static_cast<std::int64_t>(std::floor(points(a, i) / link_distance));
+    }
+    const auto& c = cell[static_cast<std::size_t>(i)];
+    grid[cell_key(c[0], c[1], c[2])].push_back(i);
+  }
+  const double link2 = link_distance * link_distance;
+  for (int i = 0; i < n; ++i) {
+    if (!finite[static_cast<std::size_t>(i)]) continue;
+    const auto& c = cell[static_cast<std::size_t>(i)];
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(cell_key(c[0] + dx, c[1] + dy, c[2] + dz));
+          if (it == grid.end()) continue;
+          for (const int j : it->second) {
+            if (j <= i || (points.col(i) - points.col(j)).squaredNorm() >= link2) continue;
+            const int ri = find_root(parent, i);
+            const int rj = find_root(parent, j);
+            if (ri != rj) parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
+          }
+        }
+      }
+    }
+  }
+  // Roots are each cluster's smallest index, so clusters come in order of their first point.
+  std::vector<std::vector<int>> clusters;
+  std::vector<int> index_of_root(static_cast<std::size_t>(n), -1);
+  for (int i = 0; i < n; ++i) {
+    if (!finite[static_cast<std::size_t>(i)]) continue;
+    const int r = find_root(parent, i);
+    int& k = index_of_root[static_cast<std::size_t>(r)];
+    if (k < 0) {
+      k = static_cast<int>(clusters.size());
+      clusters.emplace_back();
+    }
+    clusters[static_cast<std::size_t>(k)].push_back(i);
+  }
+  return clusters;
+}
+
+OccluderTracker::OccluderTracker(const TrackerSettings& settings) : settings_(settings) { validate(settings_); }
+
+void OccluderTracker::reset() {
+  tracks_.clear();
+  next_id_ = 0;
+  started_ = false;
+}
+
+void OccluderTracker::predict(double dt) {
+  // x' = F x, P' = F P F^T + Q with F = [1 dt; 0 1] and the discrete
+  // white-noise acceleration Q = q [dt^4/4 dt^3/2; dt^3/2 dt^2], q = accel_noise^2.
+  Eigen::Matrix2d f;
+  f << 1.0, dt, 0.0, 1.0;
+  const double q = settings_.accel_noise * settings_.accel_noise;
+  Eigen::Matrix2d noise;
+  noise << 0.25 * dt * dt * dt * dt, 0.5 * dt * dt * dt, 0.5 * dt * dt * dt, dt * dt;
+  for (OccluderTrack& t : tracks_) {
+    t.position += dt * t.velocity;
+    t.covariance = f * t.covariance * f.transpose() + q * noise;
+    t.centroid += dt * t.velocity;
+  }
+}
+
+const std::vector<OccluderTrack>& OccluderTracker::coast(double dt) {
+  return update(Eigen::Matrix3Xd(3, 0), dt);
+}
+
+const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd& occluders, double dt) {
+  double period = 0.0;
+  if (started_) {
+    period = dt;
+    if (!(std::isfinite(dt) && dt > 0.0)) {
+      throw std::invalid_argument("occluder tracker: time since the previous frame must be positive, got " +
+                                  format_number(dt));
+    }
+    predict(dt);
+  }
+  started_ = true;
+
+  const std::vector<std::vector<int>> clusters = cluster_points(occluders, settings_.link_distance);
+  std::vector<Eigen::Vector3d> centroids;
+  centroids.reserve(clusters.size());
+  for (const auto& c : clusters) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const int i : c) sum += occluders.col(i);
+    centroids.emplace_back(sum / static_cast<double>(c.size()));
+  }
+
+  // Greedy association, nearest pair first, within the gate.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+    const double gate = settings_.gate;
+    for (std::size_t c = 0; c < centroids.size(); ++c) {
+      const double d = (centroids[c] - tracks_[t].centroid).norm();
+      if (d < gate) pairs.emplace_back(d, t, c);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> cluster_of(tracks_.size(), -1);
+  std::vector<char> used(centroids.size(), 0);
+  for (const auto& [d, t, c] : pairs) {
+    if (cluster_of[t] >= 0 || used[c]) continue;
+    cluster_of[t] = static_cast<int>(c);
+    used[c] = 1;
+  }
+
+  // Measurement update: H = [1 0], R = measurement_noise^2.
+  const double r = settings_.measurement_noise * settings_.measurement_noise;
+  std::vector<OccluderTrack> kept;
+  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+    OccluderTrack& track = tracks_[t];
+    if (cluster_of[t] < 0) {
+      track.points.resize(3, 0);
+      if (++track.misses <= settings_.max_misses) kept.push_back(std::move(track));
+      continue;
+    }
+    const auto c = static_cast<std::size_t>(cluster_of[t]);
+    // The measurement: where the points seen last frame have moved to
+    // (registration), not the centroid, which also moves when the visible
+    // part of an occluder changes (entering the sphere, the camera moving).
+    // Without a registration (a track missed last frame, or too little
+    // overlap), the centroid's offset from its prediction stands for the
+    // position's.
+    // The registration starts from the predicted motion, or, before the
+    // track has a velocity, from the centroid's: points about one spacing
+    // apart would otherwise register one spacing short (aliasing).
+    std::optional<Eigen::Vector3d> moved;
+    if (track.points.cols() > 0) {
+      const Eigen::Vector3d guess =
+          track.hits >= 2 ? Eigen::Vector3d(period * track.velocity)
+                          : Eigen::Vector3d(centroids[c] - (track.centroid - period * track.velocity));
+      moved = register_translation(track.points, occluders, clusters[c], guess, settings_.link_distance);
+    }
+    const Eigen::Vector3d measured = moved ? Eigen::Vector3d(track.position - period * track.velocity + *moved)
+                                           : Eigen::Vector3d(track.position + centroids[c] - track.centroid);
+    track.centroid = centroids[c];
+    const Eigen::Vector2d gain = track.covariance.col(0) / (track.covariance(0, 0) + r);
+    const Eigen::Vector3d innovation = measured - track.position;
+    track.position += gain(0) * innovation;
+    track.velocity += gain(1) * innovation;
+    const Eigen::Matrix2d i_kh = Eigen::Matrix2d::Identity() - gain * Eigen::RowVector2d(1.0, 0.0);
+    track.covariance = i_kh * track.covariance;
+    track.covariance = 0.5 * (track.covariance + track.covariance.transpose()).eval();
+    track.points.resize(3, static_cast<Eigen::Index>(clusters[c].size()));
+    for (std::size_t k = 0; k < clusters[c].size(); ++k) {
+      track.points.col(static_cast<Eigen::Index>(k)) = occluders.col(clusters[c][k]);
+    }
+    ++track.hits;
+    track.misses = 0;
+    track.confirmed = track.confirmed || track.hits >= settings_.confirm_hits;
+    kept.push_back(std::move(track));
+  }
+  for (std::size_t c = 0; c < centroids.size(); ++c) {
+    if (used[c]) continue;
+    OccluderTrack track;
+    track.id = next_id_++;
+    track.position = track.centroid = centroids[c];
+    track.covariance << r, 0.0, 0.0, settings_.initial_speed_sigma * settings_.initial_speed_sigma;
+    track.points.resize(3, static_cast<Eigen::Index>(clusters[c].size()));
+    for (std::size_t k = 0; k < clusters[c].size(); ++k) {
+      track.points.col(static_cast<Eigen::Index>(k)) = occluders.col(clusters[c][k]);
+    }
+    track.hits = 1;
+    track.confirmed = settings_.confirm_hits <= 1;
+    kept.push_back(std::move(track));
+  }
+  std::sort(kept.begin(), kept.end(), [](const OccluderTrack& a, const OccluderTrack& b) { return a.id < b.id; });
+  tracks_ = std::move(kept);
+  return tracks_;
+}
+
+Eigen::Matrix3Xd predicted_occluders(const std::vector<OccluderTrack>& tracks, const std::vector<double>& times,
+                                     double min_speed) {
+  Eigen::Index count = 0;
+  const auto moving = [&](const OccluderTrack& t) {
+    return t.confirmed && t.points.cols() > 0 && t.velocity.norm() > min_speed;
+  };
+  for (const OccluderTrack& t : tracks) count += moving(t) ? t.points.cols() * static_cast<Eigen::Index>(times.size()) : 0;
+  Eigen::Matrix3Xd out(3, count);
+  Eigen::Index k = 0;
+  for (const OccluderTrack& t : tracks) {
+    if (!moving(t)) continue;
+    for (const double tau : times) {
+      out.middleCols(k, t.points.cols()) = t.points.colwise() + tau * t.velocity;
+      k += t.points.cols();
+    }
+  }
+  return out;
+}
+
+}  // namespace ofv

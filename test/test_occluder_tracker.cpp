@@ -1,0 +1,125 @@
+// Occluder clusters and their constant-velocity tracks, on scenes with known motion.
+#include "ofv/occluder_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace ofv {
+namespace {
+
+// A 4 x 4 x 2 block of points 2 cm apart, its first corner at `corner`.
+Eigen::Matrix3Xd block(const Eigen::Vector3d& corner, int nx = 4) {
+  Eigen::Matrix3Xd p(3, nx * 8);
+  for (int k = 0; k < nx * 8; ++k) p.col(k) = corner + 0.02 * Eigen::Vector3d(k % nx, (k / nx) % 4, k / (nx * 4));
+  return p;
+}
+
+Eigen::Matrix3Xd join(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  Eigen::Matrix3Xd out(3, a.cols() + b.cols());
+  out << a, b;
+  return out;
+}
+
+TEST(OccluderTracker, ClustersAreChainsOfNearPoints) {
+  // Two blocks 10 cm apart at 5 cm linkage: two clusters; a bridge of points
+  // 3 to 3.5 cm apart joins them into one.
+  const Eigen::Matrix3Xd two = join(block({0, 0, 0}), block({0.16, 0, 0}));
+  auto clusters = cluster_points(two, 0.05);
+  ASSERT_EQ(clusters.size(), 2U);
+  EXPECT_EQ(clusters[0].size(), 32U);
+  EXPECT_EQ(clusters[0].front(), 0);
+  EXPECT_EQ(clusters[1].front(), 32);
+  Eigen::Matrix3Xd bridge(3, 2);
+  bridge << 0.095, 0.125, 0.0, 0.0, 0.0, 0.0;
+  EXPECT_EQ(cluster_points(join(two, bridge), 0.05).size(), 1U);
+  // Non-finite points belong to no cluster.
+  Eigen::Matrix3Xd bad = two;
+  bad(0, 3) = std::nan("");
+  clusters = cluster_points(bad, 0.05);
+  EXPECT_EQ(clusters[0].size() + clusters[1].size(), 63U);
+}
+
+TEST(OccluderTracker, VelocityOfANoisyTranslatingClusterWithinThreeCentimetresPerSecond) {
+  // A hand-sized cluster moving at (0.6, -0.2, 0.1) m/s, 30 frames a second,
+  // every point with 3 mm of noise: after half a second the velocity is
+  // within 3 cm/s and the track was confirmed with one id throughout.
+  const Eigen::Vector3d v(0.6, -0.2, 0.1);
+  const double dt = 1.0 / 30.0;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  OccluderTracker tracker;
+  for (int k = 0; k <= 15; ++k) {
+    Eigen::Matrix3Xd p = block(Eigen::Vector3d(-0.3, 0.1, 0.3) + k * dt * v);
+    for (Eigen::Index i = 0; i < p.size(); ++i) p.data()[i] += noise(rng);
+    const auto& tracks = tracker.update(p, dt);
+    ASSERT_EQ(tracks.size(), 1U);
+    EXPECT_EQ(tracks[0].id, 0);
+  }
+  const OccluderTrack& t = tracker.tracks()[0];
+  EXPECT_TRUE(t.confirmed);
+  EXPECT_LT((t.velocity - v).norm(), 0.03) << t.velocity.transpose();
+  EXPECT_GT(t.speed_sigma(), 0.0);
+  EXPECT_EQ(t.points.cols(), 32);
+}
+
+TEST(OccluderTracker, AStillOccluderWhoseVisiblePartGrowsStaysStill) {
+  // An arm entering the sphere: its visible part grows by one 2 cm column a
+  // frame, so its centroid moves at 30 cm/s, yet the arm does not move.
+  OccluderTracker tracker;
+  for (int k = 0; k < 12; ++k) (void)tracker.update(block({0, 0, 0.3}, 4 + k), 1.0 / 30.0);
+  ASSERT_EQ(tracker.tracks().size(), 1U);
+  EXPECT_LT(tracker.tracks()[0].velocity.norm(), 0.05) << tracker.tracks()[0].velocity.transpose();
+}
+
+TEST(OccluderTracker, TwoOccludersKeepTheirTracksAndALostOneIsDropped) {
+  const double dt = 0.05;
+  OccluderTracker tracker;
+  for (int k = 0; k < 10; ++k) {
+    const double s = k * dt;
+    (void)tracker.update(join(block({-0.4 + 0.5 * s, 0, 0.3}), block({0.4 - 0.3 * s, 0.2, 0.3})), dt);
+  }
+  ASSERT_EQ(tracker.tracks().size(), 2U);
+  EXPECT_NEAR(tracker.tracks()[0].velocity.x(), 0.5, 0.02);
+  EXPECT_NEAR(tracker.tracks()[1].velocity.x(), -0.3, 0.02);
+  // The second leaves: it coasts for max_misses frames, then is dropped.
+  const int misses = tracker.settings().max_misses;
+  const auto first = [&](int k) { return block({-0.4 + 0.5 * k * dt, 0, 0.3}); };
+  for (int k = 10; k < 10 + misses; ++k) (void)tracker.update(first(k), dt);
+  EXPECT_EQ(tracker.tracks().size(), 2U);
+  EXPECT_EQ(tracker.tracks()[1].points.cols(), 0);
+  (void)tracker.update(first(10 + misses), dt);
+  ASSERT_EQ(tracker.tracks().size(), 1U);
+  EXPECT_EQ(tracker.tracks()[0].id, 0);
+}
+
+TEST(OccluderTracker, PredictionShiftsMovingTracksOnly) {
+  OccluderTrack moving;
+  moving.confirmed = true;
+  moving.velocity << 0.5, 0, 0;
+  moving.points = block({0, 0, 0});
+  OccluderTrack still = moving;
+  still.velocity << 0.01, 0, 0;
+  OccluderTrack unconfirmed = moving;
+  unconfirmed.confirmed = false;
+  const Eigen::Matrix3Xd ahead = predicted_occluders({moving, still, unconfirmed}, {0.2, 0.4}, 0.05);
+  ASSERT_EQ(ahead.cols(), 64);
+  EXPECT_TRUE(ahead.leftCols(32).isApprox(moving.points.colwise() + Eigen::Vector3d(0.1, 0, 0)));
+  EXPECT_TRUE(ahead.rightCols(32).isApprox(moving.points.colwise() + Eigen::Vector3d(0.2, 0, 0)));
+  EXPECT_EQ(predicted_occluders({still}, {0.2}, 0.05).cols(), 0);
+}
+
+TEST(OccluderTracker, SettingsAndPeriodsAreValidated) {
+  TrackerSettings s;
+  s.link_distance = 0.0;
+  EXPECT_THROW((OccluderTracker(s)), std::invalid_argument);
+  s = {};
+  s.accel_noise = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((OccluderTracker(s)), std::invalid_argument);
+  OccluderTracker tracker;
+  (void)tracker.update(block({0, 0, 0}), 0.0);  // the first frame's period is not used
+  EXPECT_THROW((void)tracker.update(block({0, 0, 0}), -1.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ofv
