@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace ofv {
@@ -322,14 +323,26 @@ constexpr std::size_t kLanes = 8;
 // at index k, its partial sum is k % kLanes. The tail of the last row is
 // padded with d = 0, which lies in the far hemisphere (d . w = 0) of every
 // iterate and so is ignored by §4 exactly as the spec ignores such points.
+// One allocation, not zero-filled (every slot read is written first): the
+// big scenes' megabytes would otherwise be cleared, or faulted in page by
+// page, once per frame.
 struct PointRows {
-  std::vector<double> x, y, z;
+  std::unique_ptr<double[]> buffer;
+  double* x = nullptr;
+  double* y = nullptr;
+  double* z = nullptr;
   std::size_t rows = 0;
-  void resize_rows(std::size_t n_rows) {
+  std::size_t capacity_rows = 0;
+  // Room for n_rows rows, contents undefined; rows is set to n_rows.
+  void reserve_rows(std::size_t n_rows) {
+    if (n_rows > capacity_rows) {
+      buffer.reset(new double[3 * n_rows * kLanes]);
+      capacity_rows = n_rows;
+      x = buffer.get();
+      y = x + n_rows * kLanes;
+      z = y + n_rows * kLanes;
+    }
     rows = n_rows;
-    x.assign(rows * kLanes, 0.0);
-    y.assign(rows * kLanes, 0.0);
-    z.assign(rows * kLanes, 0.0);
   }
 };
 
@@ -385,17 +398,22 @@ OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Ma
   }
   OcclusionRays rays;
   const std::size_t n_max = static_cast<std::size_t>(v.cols()) * n_q;
-  rays.points.resize_rows((n_max + kLanes - 1) / kLanes);
-  double* ox = rays.points.x.data();
-  double* oy = rays.points.y.data();
-  double* oz = rays.points.z.data();
+  const std::size_t n_rows = (n_max + kLanes - 1) / kLanes;
+  rays.points.reserve_rows(n_rows);
+  double* ox = rays.points.x;
+  double* oy = rays.points.y;
+  double* oz = rays.points.z;
   const double r2 = r * r;
-  std::size_t k = 0;
+  std::size_t k = 0;  // the next row is written from here on
   for (Eigen::Index n = 0; n < v.cols(); ++n) {
     const Eigen::Vector3d a = v.col(n) - c;    // v_n - C
     const double a_in = a.squaredNorm() - r2;  // < 0 inside the sphere
     sphere_exits(qx, qy, qz, n_q, a.x(), a.y(), a.z(), a_in, ox + k, oy + k, oz + k, len);
-    // Drop the coincident pairs (rare) by moving the rest down.
+    // Drop the coincident pairs (rare) by moving the rest of this row down.
+    if (std::all_of(len, len + n_q, [](double l) { return l >= kCoincidentEps; })) {
+      k += n_q;
+      continue;
+    }
     std::size_t kept = k;
     for (std::size_t b = 0; b < n_q; ++b) {
       if (len[b] >= kCoincidentEps) {
@@ -407,10 +425,10 @@ OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Ma
     }
     k = kept;
   }
-  // Zero the tail the dropped pairs left, and trim empty rows.
-  std::fill(ox + k, ox + n_max, 0.0);
-  std::fill(oy + k, oy + n_max, 0.0);
-  std::fill(oz + k, oz + n_max, 0.0);
+  // Zero the tail of the last row and the rows the dropped pairs left.
+  std::fill(ox + k, ox + n_rows * kLanes, 0.0);
+  std::fill(oy + k, oy + n_rows * kLanes, 0.0);
+  std::fill(oz + k, oz + n_rows * kLanes, 0.0);
   rays.count = k;
   rays.points.rows = (k + kLanes - 1) / kLanes;
   return rays;
@@ -503,7 +521,7 @@ Projection project(const PointRows& pts, const Eigen::Vector3d& t_from_c, double
   LaneSums sums;
   const auto run = s.push_weighting == PushWeighting::InverseDistance ? project_rows<true>
                                                                       : project_rows<false>;
-  run(pts.x.data(), pts.y.data(), pts.z.data(), pts.rows, w.x(), w.y(), w.z(), t_from_c.x(),
+  run(pts.x, pts.y, pts.z, pts.rows, w.x(), w.y(), w.z(), t_from_c.x(),
       t_from_c.y(), t_from_c.z(), r, clear2, push2, &sums);
   Projection p;
   p.in_clearance = static_cast<int>(combine(sums.count));
@@ -563,9 +581,9 @@ class PrunedPoints {
     const PointRows& a = all_.points;
     const double keep2 = keep_radius_ * keep_radius_;
     const std::size_t n = a.rows * kLanes;
-    const double* x = a.x.data();
-    const double* y = a.y.data();
-    const double* z = a.z.data();
+    const double* x = a.x;
+    const double* y = a.y;
+    const double* z = a.z;
     const double tx = t_from_c.x(), ty = t_from_c.y(), tz = t_from_c.z();
     std::size_t n_keep = count_within(x, y, z, n, tx, ty, tz, keep2);
     use_all_ = n_keep * 2 > n;
@@ -573,9 +591,7 @@ class PrunedPoints {
     // Each lane keeps its own points in order, so each partial sum of §4
     // meets the same non-zero terms in the same order.
     std::size_t lane_rows[kLanes] = {};
-    kept_.x.resize(n);
-    kept_.y.resize(n);
-    kept_.z.resize(n);
+    kept_.reserve_rows(a.rows);
     for (std::size_t l = 0; l < kLanes; ++l) {
       std::size_t m = 0;
       for (std::size_t k = l; k < n; k += kLanes) {
