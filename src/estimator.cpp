@@ -9,8 +9,12 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
+#include <memory>
+#include <vector>
 
 namespace ofv {
 namespace {
@@ -293,51 +297,140 @@ InitialViewChoice initial_view(const NormalRays& rays, const ObjectFrame& object
 // ---------------------------------------------------------------------------
 // §3: occlusion-to-sphere rays.
 
-// Occlusion-to-sphere rays d = d_nb - C in structure-of-arrays form, so that
-// one gnomonic projection of all of them is a single vectorisable loop.
-struct OcclusionRays {
-  std::vector<double> x, y, z;
-  [[nodiscard]] std::size_t size() const { return x.size(); }
+// The point kernels below are compiled for AVX-512, AVX2 and baseline x86-64,
+// picked at run time, with floating-point contraction off: every clone rounds
+// every product and sum on its own, as baseline x86-64 does (an FMA would give
+// other bits on AVX-512 machines than on the others). Together with the fixed
+// summation order of §4 below, every machine computes the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define OFV_POINT_KERNEL \
+  __attribute__((target_clones("avx512f", "avx2", "default"), optimize("fp-contract=off")))
+#elif defined(__GNUC__) && !defined(__clang__)
+#define OFV_POINT_KERNEL __attribute__((optimize("fp-contract=off")))
+#else
+#define OFV_POINT_KERNEL
+#endif
+#if defined(__clang__)
+#pragma clang fp contract(off)
+#endif
+
+// §4 sums the projected points in kLanes interleaved partial sums (see
+// sum_projection); storage is padded to whole rows of kLanes points.
+constexpr std::size_t kLanes = 8;
+
+// Points d = d_nb - C in structure-of-arrays form, kLanes per row: point k is
+// at index k, its partial sum is k % kLanes. The tail of the last row is
+// padded with d = 0, which lies in the far hemisphere (d . w = 0) of every
+// iterate and so is ignored by §4 exactly as the spec ignores such points.
+// One allocation, not zero-filled (every slot read is written first): the
+// big scenes' megabytes would otherwise be cleared, or faulted in page by
+// page, once per frame.
+struct PointRows {
+  std::unique_ptr<double[]> buffer;
+  double* x = nullptr;
+  double* y = nullptr;
+  double* z = nullptr;
+  std::size_t rows = 0;
+  std::size_t capacity_rows = 0;
+  // Room for n_rows rows, contents undefined; rows is set to n_rows.
+  void reserve_rows(std::size_t n_rows) {
+    if (n_rows > capacity_rows) {
+      buffer.reset(new double[3 * n_rows * kLanes]);
+      capacity_rows = n_rows;
+      x = buffer.get();
+      y = x + n_rows * kLanes;
+      z = y + n_rows * kLanes;
+    }
+    rows = n_rows;
+  }
 };
+
+// Occlusion-to-sphere rays: the N_C points in (n, b) order, pairs with
+// coincident v_n and q_b left out.
+struct OcclusionRays {
+  PointRows points;
+  std::size_t count = 0;  // N_C
+  [[nodiscard]] std::size_t size() const { return count; }
+};
+
+// §3 for one supervoxel a = v_n - C (a_in = |a|^2 - R^2 < 0) and every
+// occluder q_b - C: where the half-line from v_n through q_b leaves the
+// sphere, from C, written to out[b]; len[b] = |q_b - v_n|.
+OFV_POINT_KERNEL
+void sphere_exits(const double* qx, const double* qy, const double* qz, std::size_t n_q,
+                  double ax, double ay, double az, double a_in, double* ox, double* oy,
+                  double* oz, double* len) {
+#pragma omp simd
+  for (std::size_t b = 0; b < n_q; ++b) {
+    double ux = qx[b] - ax;
+    double uy = qy[b] - ay;
+    double uz = qz[b] - az;
+    const double l = std::sqrt(ux * ux + uy * uy + uz * uz);
+    const double inv = 1.0 / (l >= kCoincidentEps ? l : 1.0);
+    ux *= inv;
+    uy *= inv;
+    uz *= inv;
+    double t = ax * ux + ay * uy + az * uz;  // a . u
+    t = std::sqrt(t * t - a_in) - t;         // a + t u is on the sphere, t > 0
+    ox[b] = ax + t * ux;
+    oy[b] = ay + t * uy;
+    oz[b] = az + t * uz;
+    len[b] = l;
+  }
+}
 
 // §3: for every pair (n, b) with |q_b - v_n| >= 1e-9, where the half-line from
 // v_n through q_b leaves the sphere.
 OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Matrix3Xd& v,
                              const Eigen::Matrix3Xd& q) {
-  // All occluders at once per supervoxel, as Eigen arrays (vectorised).
-  const Eigen::ArrayXd qx = q.row(0).transpose().array() - c.x();
-  const Eigen::ArrayXd qy = q.row(1).transpose().array() - c.y();
-  const Eigen::ArrayXd qz = q.row(2).transpose().array() - c.z();
-  Eigen::ArrayXd ux(qx.size()), uy(qx.size()), uz(qx.size()), len(qx.size()), t(qx.size());
-
+  const auto n_q = static_cast<std::size_t>(q.cols());
+  std::vector<double> qc(4 * n_q);  // q_b - C by coordinate, then |q_b - v_n|
+  double* qx = qc.data();
+  double* qy = qx + n_q;
+  double* qz = qy + n_q;
+  double* len = qz + n_q;
+  for (std::size_t b = 0; b < n_q; ++b) {
+    const auto col = static_cast<Eigen::Index>(b);
+    qx[b] = q(0, col) - c.x();
+    qy[b] = q(1, col) - c.y();
+    qz[b] = q(2, col) - c.z();
+  }
   OcclusionRays rays;
-  const auto reserve = static_cast<std::size_t>(v.cols() * q.cols());
-  rays.x.reserve(reserve);
-  rays.y.reserve(reserve);
-  rays.z.reserve(reserve);
+  const std::size_t n_max = static_cast<std::size_t>(v.cols()) * n_q;
+  const std::size_t n_rows = (n_max + kLanes - 1) / kLanes;
+  rays.points.reserve_rows(n_rows);
+  double* ox = rays.points.x;
+  double* oy = rays.points.y;
+  double* oz = rays.points.z;
   const double r2 = r * r;
+  std::size_t k = 0;  // the next row is written from here on
   for (Eigen::Index n = 0; n < v.cols(); ++n) {
     const Eigen::Vector3d a = v.col(n) - c;    // v_n - C
     const double a_in = a.squaredNorm() - r2;  // < 0 inside the sphere
-    // The half-line from v_n through q_b leaves the sphere at a + t u (from C).
-    ux = qx - a.x();
-    uy = qy - a.y();
-    uz = qz - a.z();
-    len = (ux.square() + uy.square() + uz.square()).sqrt();
-    const Eigen::ArrayXd inv = (len >= kCoincidentEps).select(len, 1.0).inverse();
-    ux *= inv;
-    uy *= inv;
-    uz *= inv;
-    t = a.x() * ux + a.y() * uy + a.z() * uz;  // a . u
-    t = (t.square() - a_in).sqrt() - t;
-    for (Eigen::Index b = 0; b < qx.size(); ++b) {
-      if (len(b) >= kCoincidentEps) {
-        rays.x.push_back(a.x() + t(b) * ux(b));
-        rays.y.push_back(a.y() + t(b) * uy(b));
-        rays.z.push_back(a.z() + t(b) * uz(b));
+    sphere_exits(qx, qy, qz, n_q, a.x(), a.y(), a.z(), a_in, ox + k, oy + k, oz + k, len);
+    // Drop the coincident pairs (rare) by moving the rest of this row down.
+    if (std::all_of(len, len + n_q, [](double l) { return l >= kCoincidentEps; })) {
+      k += n_q;
+      continue;
+    }
+    std::size_t kept = k;
+    for (std::size_t b = 0; b < n_q; ++b) {
+      if (len[b] >= kCoincidentEps) {
+        ox[kept] = ox[k + b];
+        oy[kept] = oy[k + b];
+        oz[kept] = oz[k + b];
+        ++kept;
       }
     }
+    k = kept;
   }
+  // Zero the tail of the last row and the rows the dropped pairs left.
+  std::fill(ox + k, ox + n_rows * kLanes, 0.0);
+  std::fill(oy + k, oy + n_rows * kLanes, 0.0);
+  std::fill(oz + k, oz + n_rows * kLanes, 0.0);
+  rays.count = k;
+  rays.points.rows = (k + kLanes - 1) / kLanes;
   return rays;
 }
 
@@ -363,75 +456,189 @@ struct Projection {
   Eigen::Vector3d push = Eigen::Vector3d::Zero();  // v
 };
 
-// §4 projection, stop-test count and push sum in one pass. Compiled for
-// AVX-512, AVX2 and baseline x86-64, picked at run time: the wider the
-// vectors, the faster; only the reductions' summation order differs.
+// Per-lane partial sums of one projection (count, v).
+struct LaneSums {
+  double count[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {};
+};
+
+// §4 projection, stop-test count and push terms of `rows` rows of points, one
+// pass. Each term is computed as the spec writes it (d_pi - t with d_pi = C +
+// d R / (d . w), compared squared), and added to the partial sum of its lane,
+// in row order.
 template <bool kInverse>
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
-Projection project_impl(const OcclusionRays& rays, const Eigen::Vector3d& t_from_c, double r,
-                        double clearance, double push_radius) {
-  const Eigen::Vector3d w = t_from_c.normalized();
-  const double wx = w.x(), wy = w.y(), wz = w.z();
-  const double tx = t_from_c.x(), ty = t_from_c.y(), tz = t_from_c.z();
-  const double clear2 = clearance * clearance;
-  const double push2 = push_radius * push_radius;
-  const double* dx = rays.x.data();
-  const double* dy = rays.y.data();
-  const double* dz = rays.z.data();
-  const auto n = static_cast<std::ptrdiff_t>(rays.size());
-  // Counted in a double so that the loop vectorises (exact below 2^53).
-  double count = 0.0;
-  double vx = 0.0, vy = 0.0, vz = 0.0;
-#pragma omp simd reduction(+ : count, vx, vy, vz)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
-    const double dw = dx[k] * wx + dy[k] * wy + dz[k] * wz;
-    const double seen = dw > kFarHemisphereEps ? 1.0 : 0.0;
-    const double scale = r / (dw > kFarHemisphereEps ? dw : 1.0);
-    // d_pi - t, with d_pi = C + d R / (d . w)
-    const double px = dx[k] * scale - tx;
-    const double py = dy[k] * scale - ty;
-    const double pz = dz[k] * scale - tz;
-    const double dist2 = px * px + py * py + pz * pz;
-    count += dist2 < clear2 ? seen : 0.0;
-    double weight = dist2 < push2 ? seen : 0.0;
-    if constexpr (kInverse) {
-      weight /= dist2;
+OFV_POINT_KERNEL void project_rows(const double* dx, const double* dy, const double* dz,
+                                   std::size_t rows, double wx, double wy, double wz, double tx,
+                                   double ty, double tz, double r, double clear2, double push2,
+                                   LaneSums* sums) {
+  double count[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {};
+  for (std::size_t row = 0; row < rows; ++row) {
+    const std::size_t o = row * kLanes;
+#pragma omp simd
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      const double x = dx[o + l], y = dy[o + l], z = dz[o + l];
+      const double dw = x * wx + y * wy + z * wz;
+      const double seen = dw > kFarHemisphereEps ? 1.0 : 0.0;
+      const double scale = r / (dw > kFarHemisphereEps ? dw : 1.0);
+      // d_pi - t, with d_pi = C + d R / (d . w)
+      const double px = x * scale - tx;
+      const double py = y * scale - ty;
+      const double pz = z * scale - tz;
+      const double dist2 = px * px + py * py + pz * pz;
+      count[l] += dist2 < clear2 ? seen : 0.0;
+      double weight = dist2 < push2 ? seen : 0.0;
+      if constexpr (kInverse) {
+        weight /= dist2;
+      }
+      vx[l] -= weight * px;
+      vy[l] -= weight * py;
+      vz[l] -= weight * pz;
     }
-    vx -= weight * px;
-    vy -= weight * py;
-    vz -= weight * pz;
   }
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    sums->count[l] = count[l];
+    sums->vx[l] = vx[l];
+    sums->vy[l] = vy[l];
+    sums->vz[l] = vz[l];
+  }
+}
+
+// The documented summation order of v (spec §4 allows any): the term of point
+// k goes to partial sum k % 8, added in increasing k; the partial sums are
+// then added as ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)). Points that
+// are not in J contribute an exact zero, so leaving them out of a partial sum
+// (pruning, below) does not change it; and since the lanes are fixed, neither
+// does the vector width of the machine. The count is exact in any order.
+double combine(const double (&s)[kLanes]) {
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+// §4: gnomonic projection onto the plane tangent at t of the points `pts`.
+Projection project(const PointRows& pts, const Eigen::Vector3d& t_from_c, double r,
+                   const EstimatorSettings& s) {
+  const Eigen::Vector3d w = t_from_c.normalized();
+  const double clear2 = s.clearance * s.clearance;
+  const double push2 = s.push_radius * s.push_radius;
+  LaneSums sums;
+  const auto run = s.push_weighting == PushWeighting::InverseDistance ? project_rows<true>
+                                                                      : project_rows<false>;
+  run(pts.x, pts.y, pts.z, pts.rows, w.x(), w.y(), w.z(), t_from_c.x(),
+      t_from_c.y(), t_from_c.z(), r, clear2, push2, &sums);
   Projection p;
-  p.in_clearance = static_cast<int>(count);
-  p.push = Eigen::Vector3d(vx, vy, vz);
+  p.in_clearance = static_cast<int>(combine(sums.count));
+  p.push = Eigen::Vector3d(combine(sums.vx), combine(sums.vy), combine(sums.vz));
   return p;
 }
 
-// §4: gnomonic projection of every occlusion ray onto the plane tangent at t.
-Projection project(const OcclusionRays& rays, const Eigen::Vector3d& t_from_c, double r,
-                   const EstimatorSettings& s) {
-  return s.push_weighting == PushWeighting::InverseDistance
-             ? project_impl<true>(rays, t_from_c, r, s.clearance, s.push_radius)
-             : project_impl<false>(rays, t_from_c, r, s.clearance, s.push_radius);
+// How many of the n points are closer than sqrt(keep2) to t.
+OFV_POINT_KERNEL std::size_t count_within(const double* x, const double* y, const double* z,
+                                        std::size_t n, double tx, double ty, double tz,
+                                        double keep2) {
+  std::size_t kept = 0;
+#pragma omp simd reduction(+ : kept)
+  for (std::size_t k = 0; k < n; ++k) {
+    const double ex = x[k] - tx, ey = y[k] - ty, ez = z[k] - tz;
+    kept += ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
+  }
+  return kept;
 }
 
+// Pruning. A point d on the sphere at angle a from w projects at distance
+// R tan(a) from t, and its chord to t - C is 2 R sin(a/2) <= R tan(a) for a
+// in [0, 90 deg); beyond 90 deg it has no image. So a point whose chord to the
+// iterate is at least rho = max(clearance, push_radius) is neither counted in
+// the clearance disc nor in J: its terms are exact zeros. The margins
+// (relative 1e-9, absolute 1e-9 R) cover the rounding of the stored points
+// and iterates off the sphere (~1e-16 R) and of the computed distances.
+//
+// The kept set is chosen at an iterate t_k with `slack` to spare, and stays
+// valid while the iterate is within `slack` of t_k (triangle inequality), so
+// one selection serves several iterations. When it would keep most points,
+// all points are used (copying would cost more than it saves).
+class PrunedPoints {
+ public:
+  PrunedPoints(const OcclusionRays& all, const EstimatorSettings& s)
+      : all_(all), r_(s.r_sphere) {
+    const double rho = std::max(s.clearance, s.push_radius);
+    slack_ = std::max(4.0 * s.step, 0.25 * rho);
+    keep_radius_ = rho * (1.0 + 1e-9) + 1e-9 * r_ + slack_;
+    // Every chord is at most 2R: then nothing can ever be left out.
+    never_ = keep_radius_ >= 2.0 * r_ * (1.0 - 1e-9) || all.points.rows < 4;
+  }
+
+  // The points that may count or push at the iterate t - C.
+  const PointRows& at(const Eigen::Vector3d& t_from_c) {
+    if (never_) return all_.points;
+    if (!valid_ || !((t_from_c - centre_).norm() * (1.0 + 1e-9) + 1e-9 * r_ <= slack_)) {
+      select(t_from_c);
+    }
+    return use_all_ ? all_.points : kept_;
+  }
+
+ private:
+  void select(const Eigen::Vector3d& t_from_c) {
+    centre_ = t_from_c;
+    valid_ = true;
+    const PointRows& a = all_.points;
+    const double keep2 = keep_radius_ * keep_radius_;
+    const std::size_t n = a.rows * kLanes;
+    const double* x = a.x;
+    const double* y = a.y;
+    const double* z = a.z;
+    const double tx = t_from_c.x(), ty = t_from_c.y(), tz = t_from_c.z();
+    std::size_t n_keep = count_within(x, y, z, n, tx, ty, tz, keep2);
+    use_all_ = n_keep * 2 > n;
+    if (use_all_) return;
+    // Each lane keeps its own points in order, so each partial sum of §4
+    // meets the same non-zero terms in the same order.
+    std::size_t lane_rows[kLanes] = {};
+    kept_.reserve_rows(a.rows);
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      std::size_t m = 0;
+      for (std::size_t k = l; k < n; k += kLanes) {
+        const double ex = x[k] - tx, ey = y[k] - ty, ez = z[k] - tz;
+        kept_.x[m * kLanes + l] = x[k];
+        kept_.y[m * kLanes + l] = y[k];
+        kept_.z[m * kLanes + l] = z[k];
+        m += ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
+      }
+      lane_rows[l] = m;
+    }
+    kept_.rows = *std::max_element(lane_rows, lane_rows + kLanes);
+    for (std::size_t l = 0; l < kLanes; ++l) {  // pad with d = 0 (no image)
+      for (std::size_t m = lane_rows[l]; m < kept_.rows; ++m) {
+        kept_.x[m * kLanes + l] = kept_.y[m * kLanes + l] = kept_.z[m * kLanes + l] = 0.0;
+      }
+    }
+  }
+
+  const OcclusionRays& all_;
+  double r_;
+  double slack_ = 0.0;
+  double keep_radius_ = 0.0;
+  bool never_ = false;
+  bool valid_ = false;
+  bool use_all_ = true;
+  Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  PointRows kept_;
+};
+
 // t - d_pi for the projected point nearest to t (spec §4 fallback); zero if none.
+// Scans every point: the nearest may be outside the push disc.
 Eigen::Vector3d away_from_nearest(const OcclusionRays& rays, const Eigen::Vector3d& t_from_c,
                                   double r) {
   const Eigen::Vector3d w = t_from_c.normalized();
   double best = std::numeric_limits<double>::infinity();
   Eigen::Vector3d away = Eigen::Vector3d::Zero();
+  const PointRows& pts = rays.points;
   for (std::size_t k = 0; k < rays.size(); ++k) {
-    const Eigen::Vector3d d(rays.x[k], rays.y[k], rays.z[k]);
-    const double dw = d.dot(w);
+    const double dw = pts.x[k] * w.x() + pts.y[k] * w.y() + pts.z[k] * w.z();
     if (dw <= kFarHemisphereEps) {
       continue;
     }
-    const Eigen::Vector3d p = d * (r / dw) - t_from_c;
-    const double dist2 = p.squaredNorm();
+    const double scale = r / dw;
+    const Eigen::Vector3d p(pts.x[k] * scale - t_from_c.x(), pts.y[k] * scale - t_from_c.y(),
+                            pts.z[k] * scale - t_from_c.z());
+    const double dist2 = p.x() * p.x() + p.y() * p.y() + p.z() * p.z();
     if (dist2 < best) {
       best = dist2;
       away = -p;
@@ -530,6 +737,7 @@ IterationResult iterate(const OcclusionRays& occ, const Eigen::Vector3d& start,
   Eigen::Vector3d t = start;
   BestIterate best(start);
   CycleDetector cycle(start);
+  PrunedPoints points(occ, settings);
   bool cycling = false;
   for (int i = 0;; ++i) {
     if (cycling) {
@@ -537,7 +745,7 @@ IterationResult iterate(const OcclusionRays& occ, const Eigen::Vector3d& start,
     }
     if (path) path->push_back(t);
     const Eigen::Vector3d t_from_c = t - c;
-    const Projection proj = project(occ, t_from_c, r, settings);
+    const Projection proj = project(points.at(t_from_c), t_from_c, r, settings);
     if (proj.in_clearance == 0) {
       return {t, ViewStatus::Converged, i, 0};
     }

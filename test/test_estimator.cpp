@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
+#include <vector>
 #include <stdexcept>
 
 namespace ofv {
@@ -549,6 +551,134 @@ TEST(Geometry, SphereExitFromInsideLandsOnTheSphere) {
   }
   EXPECT_NEAR(angle_between({1, 0, 0}, {0, 2, 0}), kPi / 2, 1e-15);
   EXPECT_NEAR(angle_between({1, 0, 0}, {-1, 1e-20, 0}), kPi, 1e-15);
+}
+
+// ---------------------------------------------------------------------------
+// Speed work (issue #12): pruning and the vectorised kernels must not change a
+// bit. A deliberately plain reference of §3 and §4 (no pruning, one point at a
+// time, the documented summation order: point k into partial sum k % 8,
+// partial sums added ((s0+s1)+(s2+s3))+((s4+s5)+(s6+s7))) must visit exactly
+// the iterates the library visits.
+namespace reference {
+
+struct Result {
+  std::vector<Eigen::Vector3d> path;
+  int in_clearance_at_end = 0;
+};
+
+double combine(const double (&s)[8]) {
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+// Converged or cycle-free runs only: returns the path up to the first clear
+// iterate, or max_iterations + 1 iterates.
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("fp-contract=off")))
+#endif
+Result iterate(const UsableInput& in, const Eigen::Vector3d& c, const Eigen::Vector3d& start,
+               const EstimatorSettings& s) {
+  const double r = s.r_sphere;
+  std::vector<double> dx, dy, dz;  // §3, as the library rounds it
+  for (Eigen::Index n = 0; n < in.positions.cols(); ++n) {
+    const double ax = in.positions(0, n) - c.x(), ay = in.positions(1, n) - c.y(),
+                 az = in.positions(2, n) - c.z();
+    const double a_in = (ax * ax + ay * ay) + az * az - r * r;
+    for (Eigen::Index b = 0; b < in.occluders.cols(); ++b) {
+      double ux = (in.occluders(0, b) - c.x()) - ax;
+      double uy = (in.occluders(1, b) - c.y()) - ay;
+      double uz = (in.occluders(2, b) - c.z()) - az;
+      const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
+      if (!(len >= 1e-9)) continue;
+      const double inv = 1.0 / len;
+      ux *= inv;
+      uy *= inv;
+      uz *= inv;
+      double t = ax * ux + ay * uy + az * uz;
+      t = std::sqrt(t * t - a_in) - t;
+      dx.push_back(ax + t * ux);
+      dy.push_back(ay + t * uy);
+      dz.push_back(az + t * uz);
+    }
+  }
+  Result res;
+  Eigen::Vector3d t = start;
+  for (int i = 0;; ++i) {
+    res.path.push_back(t);
+    const Eigen::Vector3d tc = t - c;
+    const Eigen::Vector3d w = tc.normalized();
+    double count[8] = {}, vx[8] = {}, vy[8] = {}, vz[8] = {};
+    for (std::size_t k = 0; k < dx.size(); ++k) {
+      const double dw = dx[k] * w.x() + dy[k] * w.y() + dz[k] * w.z();
+      if (dw <= 1e-9) continue;
+      const double scale = r / dw;
+      const double px = dx[k] * scale - tc.x(), py = dy[k] * scale - tc.y(),
+                   pz = dz[k] * scale - tc.z();
+      const double dist2 = px * px + py * py + pz * pz;
+      if (dist2 < s.clearance * s.clearance) count[k % 8] += 1.0;
+      if (dist2 < s.push_radius * s.push_radius) {
+        const double weight =
+            s.push_weighting == PushWeighting::InverseDistance ? 1.0 / dist2 : 1.0;
+        vx[k % 8] -= weight * px;
+        vy[k % 8] -= weight * py;
+        vz[k % 8] -= weight * pz;
+      }
+    }
+    res.in_clearance_at_end = static_cast<int>(combine(count));
+    if (res.in_clearance_at_end == 0 || i == s.max_iterations) return res;
+    const Eigen::Vector3d v(combine(vx), combine(vy), combine(vz));
+    if (v.norm() < 1e-12) return res;  // the fallbacks are not this test's subject
+    const Eigen::Vector3d t_pi = t + s.step * v.normalized();
+    t = c + r * (t_pi - c).normalized();
+  }
+}
+
+}  // namespace reference
+
+// Random scenes (fixed seeds), around a patch, with the default push radius
+// (little to prune) and with push_radius = r_seed (most points pruned), both
+// weightings: every visited iterate is bit-for-bit the plain reference's.
+TEST(EstimatorSpeed, PruningAndKernelsGiveTheReferenceIteratesBitForBit) {
+#if defined(__FMA__)
+  GTEST_SKIP() << "this test file is built with FMA contraction; the library is not";
+#endif
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int compared = 0, pruned_scenes = 0;
+  for (int scene = 0; scene < 60; ++scene) {
+    ViewProblem p = patch(5, 4, 0.03);
+    const int b = 5 + scene % 40;
+    p.occluders.resize(3, b);
+    const Eigen::Vector3d hand(0.1 * u(rng), 0.1 * u(rng), 0.6 + 0.3 * std::abs(u(rng)));
+    for (int k = 0; k < b; ++k) {
+      p.occluders.col(k) = hand + Eigen::Vector3d(0.06 * u(rng), 0.06 * u(rng), 0.03 * u(rng));
+    }
+    EstimatorSettings s;
+    if (scene % 2 == 1) {
+      s.push_radius = s.r_seed;
+      ++pruned_scenes;
+    }
+    if (scene % 3 == 2) s.push_weighting = PushWeighting::InverseDistance;
+    s.max_iterations = 200;
+    EstimateOptions o;
+    o.record_path = true;
+    const ViewEstimate e = estimate_view(p, s, o);
+    const UsableInput in = usable_input(p, e.centroid, s.r_sphere);
+    const reference::Result ref = reference::iterate(in, e.centroid, e.t0, s);
+    if (e.status == ViewStatus::NotConverged && e.path.size() != ref.path.size()) {
+      continue;  // a cycle cut short, or a fallback push: not this test's subject
+    }
+    ASSERT_EQ(e.path.size(), ref.path.size()) << "scene " << scene;
+    for (std::size_t i = 0; i < ref.path.size(); ++i) {
+      ASSERT_EQ(e.path[i], ref.path[i]) << "scene " << scene << " iterate " << i;
+    }
+    if (e.status == ViewStatus::Converged) {
+      EXPECT_EQ(e.tf, ref.path.back());
+      EXPECT_EQ(e.iterations + 1, static_cast<int>(ref.path.size()));
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 50);
+  EXPECT_GT(pruned_scenes, 0);
 }
 
 }  // namespace
