@@ -76,11 +76,23 @@ std::unique_ptr<CameraRobot> real_robot(const std::string& name, const vpHomogen
   return nullptr;
 }
 
-// One JSON line per command (dry run): frame, time, status, twist (17 digits), safety action.
-void print_command(long frame, double t, const char* status, const vpColVector& v, const char* safety) {
+// One JSON line per command (dry run): frame, time, status, twist (17 digits),
+// safety action, the confirmed occluder tracks seen in the frame (id,
+// position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
+void print_command(long frame, double t, const char* status, const vpColVector& v, const char* safety,
+                   const std::vector<OccluderTrack>& tracks = {}) {
   std::printf("{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
   for (unsigned i = 0; i < 6; ++i) std::printf("%s%.17g", i ? ", " : "", v[i]);
-  std::printf("], \"safety\": \"%s\"}\n", safety);
+  std::printf("], \"safety\": \"%s\", \"tracks\": [", safety);
+  bool first = true;
+  for (const OccluderTrack& k : tracks) {
+    if (!k.confirmed || k.points.cols() == 0) continue;
+    std::printf("%s{\"id\": %d, \"p\": [%.6g, %.6g, %.6g], \"v\": [%.6g, %.6g, %.6g], \"sigma_v\": %.6g}",
+                first ? "" : ", ", k.id, k.position.x(), k.position.y(), k.position.z(), k.velocity.x(),
+                k.velocity.y(), k.velocity.z(), k.speed_sigma());
+    first = false;
+  }
+  std::printf("]}\n");
 }
 
 }  // namespace
@@ -151,7 +163,8 @@ Command add_run_command(CLI::App& app) {
             std::signal(SIGTERM, on_signal);
             const auto print = [&](const RobotLoopFrame& f) {
               if (opt->dry_run) {
-                print_command(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity, to_string(f.step->safety));
+                print_command(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
+                              to_string(f.step->safety), f.step->tracks);
               }
             };
             try {
