@@ -87,6 +87,15 @@ struct Perception::Impl {
   // foreign voxels of a mixed boundary supervoxel (a hand's, the table's)
   // never become object and cannot pull their neighbours in next frame.
   std::vector<char> voxel_matched;
+  // object_motion(): the frame's object voxels (hashed) and normals, and the
+  // voxels on the object's own outline with the outline's outward normal,
+  // of this frame and of the previous one.
+  std::vector<Eigen::Vector3f> moved;
+  std::vector<Eigen::Vector3f> moved_normals;
+  detail::PointGrid moved_grid;
+  std::vector<Eigen::Vector3f> outline, outline_normals;
+  std::vector<Eigen::Vector3f> previous_outline, previous_outline_normals;
+  detail::PointGrid outline_grid;
 
   // Object state carried from frame to frame (world frame).
   bool initialised = false;
@@ -140,7 +149,13 @@ struct Perception::Impl {
   /// pipeline.cpp: r.status and r.message from the object found; the first
   /// frame found also sets the state's start (initialised, initial_voxels).
   void set_status(PerceptionResult& r, const std::vector<char>& object, std::string why);
-  /// object_memory.cpp: the memory updated with the frame's object.
+  /// object_memory.cpp: the object's rigid motion from the previous frame
+  /// to this one (world frame), from its visible voxels matched against the
+  /// memory; identity when it cannot be told (TrackingSettings::follow_motion).
+  Eigen::Isometry3d object_motion(const RgbdFrame& frame, const PerceptionResult& r,
+                                  const std::vector<char>& object);
+  /// object_memory.cpp: the memory updated with the frame's object; its
+  /// hidden part moved by object_motion() first.
   void remember(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<char>& object);
   /// classify.cpp: C, axes, OBB, labels and r.problem.
   void classify(PerceptionResult& r, const std::vector<char>& object);

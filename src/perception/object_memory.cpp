@@ -3,8 +3,13 @@
 // for a while what is hidden.
 #include "front_end.h"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <limits>
+#include <optional>
 #include <vector>
 
 namespace ofv {
@@ -43,11 +48,211 @@ std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
   return object;
 }
 
+namespace {
+
+/// Nearest of `points` (hashed in `grid`, cells >= radius) to p within
+/// radius that has accept(j); -1 when none.
+template <typename Accept>
+int nearest(const detail::PointGrid& grid, const std::vector<Eigen::Vector3f>& points,
+            const Eigen::Vector3f& p, float radius, Accept&& accept) {
+  int best = -1;
+  float best_d2 = radius * radius;
+  grid.for_each_near(p, [&](int j) {
+    const float d2 = (points[static_cast<std::size_t>(j)] - p).squaredNorm();
+    if (d2 <= best_d2 && accept(j)) {
+      best_d2 = d2;
+      best = j;
+    }
+  });
+  return best;
+}
+
+}  // namespace
+
+Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
+                                                  const PerceptionResult& r,
+                                                  const std::vector<char>& object) {
+  const TrackingSettings& t = settings.tracking;
+  if (!t.follow_motion) {
+    return Eigen::Isometry3d::Identity();
+  }
+  const double res = settings.supervoxels.voxel_resolution;
+  // The frame's object voxels (those that may enter the memory), each with
+  // its supervoxel's normal.
+  moved.clear();
+  moved_normals.clear();
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    if (object[owner] && voxel_matched[i]) {
+      moved.push_back(r.voxels[i]);
+      moved_normals.push_back(r.supervoxels[owner].normal_valid
+                                  ? Eigen::Vector3f(r.supervoxels[owner].normal.cast<float>())
+                                  : Eigen::Vector3f::Zero());
+    }
+  }
+
+  // Its outline: voxels whose neighbours lie to one side within the surface.
+  // Only the object's own outline tells how it moves in its plane; where an
+  // occluder (something nearer the camera just outside) or the image border
+  // cuts it, or nothing is seen there, the outline stays where the cut is.
+  const auto neighbourhood = static_cast<float>(1.5 * res);
+  moved_grid.build(moved, neighbourhood);
+  const Eigen::Isometry3d cMw = frame.wMc.inverse();
+  const CameraIntrinsics& k = frame.intrinsics;
+  const double in_front = 0.5 * t.max_motion;
+  // The outline found in the depth image, to the pixel: from voxel p walk
+  // outward (m) over the pixels while they show the surface; the last one is
+  // the edge. nullopt when what lies beyond is nearer the camera (an
+  // occluder cuts the object there) or the walk leaves the image.
+  const auto edge = [&](const Eigen::Vector3d& p,
+                        const Eigen::Vector3d& m) -> std::optional<Eigen::Vector3f> {
+    double z0 = 0.0;
+    double z1 = 0.0;
+    const auto p0 = detail::project(frame, cMw, p, &z0);
+    const auto p1 = detail::project(frame, cMw, p + res * m, &z1);
+    if (!p0 || !p1) return std::nullopt;
+    const Eigen::Vector2d step = *p1 - *p0;
+    const double pixels_per_voxel = step.norm();
+    if (!(pixels_per_voxel > 0.5)) return std::nullopt;
+    const Eigen::Vector2d dir = step / pixels_per_voxel;
+    const int max_steps = static_cast<int>(std::ceil(3.0 * pixels_per_voxel));
+    std::optional<Eigen::Vector3f> last;
+    double z_last = z0;
+    int s_last = max_steps;
+    for (int s = 0; s <= max_steps; ++s) {
+      const Eigen::Vector2d px = *p0 + static_cast<double>(s) * dir;
+      const int u = static_cast<int>(std::lround(px.x()));
+      const int v = static_cast<int>(std::lround(px.y()));
+      if (u < 0 || v < 0 || u >= k.width || v >= k.height) return std::nullopt;
+      const float observed = frame.depth[frame.index(u, v)];
+      if (!(std::isfinite(observed) && observed > 0.0f)) continue;  // drop-out: look further
+      // Depth expected on the surface here (it may be slanted).
+      const double expected = z0 + (z1 - z0) * static_cast<double>(s) / pixels_per_voxel;
+      const auto d = static_cast<double>(observed);
+      if (std::abs(d - expected) <= in_front && std::abs(d - z_last) <= in_front) {
+        const Eigen::Vector3d pc((px.x() - k.cx) * d / k.fx, (px.y() - k.cy) * d / k.fy, d);
+        last = (frame.wMc * pc).cast<float>();
+        z_last = d;
+        s_last = s;
+        continue;
+      }
+      if (d < expected - in_front || !last) return std::nullopt;  // occluded edge
+      return s_last < max_steps ? last : std::nullopt;
+    }
+    // Nothing seen beyond the surface (out of range, or drop-outs): the
+    // edge, if the walk went a pixel or more past it.
+    return last;
+  };
+  outline.clear();
+  outline_normals.clear();
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    const Eigen::Vector3f& p = moved[i];
+    Eigen::Vector3f offset = Eigen::Vector3f::Zero();
+    int count = 0;
+    moved_grid.for_each_near(p, [&](int j) {
+      const Eigen::Vector3f d = moved[static_cast<std::size_t>(j)] - p;
+      if (static_cast<std::size_t>(j) != i && d.squaredNorm() <= neighbourhood * neighbourhood) {
+        offset += d;
+        ++count;
+      }
+    });
+    if (count == 0) continue;
+    offset /= static_cast<float>(count);
+    const Eigen::Vector3f& n = moved_normals[i];
+    offset -= n * n.dot(offset);  // within the surface (n = 0: as is)
+    if (offset.norm() < static_cast<float>(0.35 * res)) continue;  // inside
+    const Eigen::Vector3f m = -offset.normalized();
+    if (const auto e = edge(p.cast<double>(), m.cast<double>())) {
+      outline.push_back(*e);
+      outline_normals.push_back(m);
+    }
+  }
+
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  const std::size_t min_points = 20;
+  if (memory.size() >= min_points && moved.size() >= min_points) {
+    // Gauss-Newton on A, this frame -> the previous (x -> R (x - c) + c + t,
+    // small angles): point-to-plane to the nearest memory voxel, and along
+    // the outline's normal to the nearest previous outline voxel facing the
+    // same way. A weak prior on zero motion keeps what nothing constrains at zero.
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3f& p : moved) c += p.cast<double>();
+    c /= static_cast<double>(moved.size());
+    const auto radius = static_cast<float>(t.max_motion);
+    grid.build(memory, t.max_motion);
+    outline_grid.build(previous_outline, t.max_motion);
+    Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+    std::size_t matched = 0;
+    for (int iteration = 0; iteration < 6; ++iteration) {
+      Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
+      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+      matched = 0;
+      const auto add = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& dir, double residual,
+                           bool turns) {
+        // Huber weight: a voxel off by more than half a voxel counts less.
+        const double w = std::min(1.0, 0.5 * res / std::max(std::abs(residual), 1e-12));
+        Eigen::Matrix<double, 6, 1> j;
+        j.head<3>() = turns ? Eigen::Vector3d((x - c).cross(dir)) : Eigen::Vector3d::Zero();
+        j.tail<3>() = dir;
+        h += w * j * j.transpose();
+        g += w * j * residual;
+      };
+      for (std::size_t i = 0; i < moved.size(); ++i) {
+        if (moved_normals[i].isZero()) continue;
+        const Eigen::Vector3d x = a * moved[i].cast<double>();
+        const int q = nearest(grid, memory, x.cast<float>(), radius, [](int) { return true; });
+        if (q < 0) continue;
+        ++matched;
+        const Eigen::Vector3d n = a.linear() * moved_normals[i].cast<double>();
+        add(x, n, n.dot(x - memory[static_cast<std::size_t>(q)].cast<double>()), true);
+      }
+      for (std::size_t i = 0; i < outline.size(); ++i) {
+        const Eigen::Vector3d x = a * outline[i].cast<double>();
+        const Eigen::Vector3d m = a.linear() * outline_normals[i].cast<double>();
+        const int q = nearest(outline_grid, previous_outline, x.cast<float>(), radius, [&](int j) {
+          return previous_outline_normals[static_cast<std::size_t>(j)].cast<double>().dot(m) > 0.7;
+        });
+        if (q < 0) continue;
+        // Translation only: the outline is too coarse to tell a turn.
+        add(x, m, m.dot(x - previous_outline[static_cast<std::size_t>(q)].cast<double>()), false);
+      }
+      if (matched < min_points) break;
+      Eigen::Matrix<double, 6, 1> prior;
+      prior << Eigen::Vector3d::Constant(2.0 * 0.05 * 0.05), Eigen::Vector3d::Constant(2.0);
+      h.diagonal() += prior;
+      const Eigen::Matrix<double, 6, 1> step = -h.ldlt().solve(g);
+      if (!step.allFinite()) break;
+      Eigen::Isometry3d update = Eigen::Isometry3d::Identity();
+      const double angle = step.head<3>().norm();
+      if (angle > 0.0) {
+        update.linear() = Eigen::AngleAxisd(angle, step.head<3>() / angle).toRotationMatrix();
+      }
+      update.translation() = c - update.linear() * c + step.tail<3>();
+      a = update * a;
+      if (step.tail<3>().norm() < 1e-5 && angle < 1e-4) break;
+    }
+    // The motion is small (paper assumption 2): anything else is a wrong fit.
+    const Eigen::Isometry3d d = a.inverse();
+    const double angle = Eigen::AngleAxisd(d.linear()).angle();
+    const double displacement = (d * c - c).norm();
+    if (matched >= moved.size() / 2 && matched >= min_points && displacement <= t.max_motion &&
+        angle <= 0.1) {
+      motion = d;
+    }
+  }
+  previous_outline.swap(outline);
+  previous_outline_normals.swap(outline_normals);
+  return motion;
+}
+
 void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& r,
                                 const std::vector<char>& object) {
   // Old object voxels now hidden behind something nearer the camera (or out
   // of the image) stay in the state for a while, so that the object's
   // occluded part is recognised when it reappears.
+  // They follow the object's motion, estimated from what is seen of it.
+  const Eigen::Isometry3d motion = object_motion(frame, r, object);
+  const Eigen::Isometry3f motion_f = motion.cast<float>();
   std::vector<Eigen::Vector3f> next;
   std::vector<Eigen::Vector3f> next_chroma;
   std::vector<int> next_age;
@@ -63,6 +268,7 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
   const double tolerance = settings.tracking.max_motion;
   const int max_age = settings.tracking.occlusion_memory_frames;
   for (std::size_t i = 0; i < memory.size(); ++i) {
+    memory[i] = motion_f * memory[i];
     if (memory_age[i] + 1 <= max_age &&
         detail::hidden(frame, cMw, memory[i].cast<double>(), tolerance)) {
       next.push_back(memory[i]);
@@ -84,7 +290,9 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
   }
   const std::size_t seen = vertices.size();
   const double spacing = 0.5 * settings.supervoxels.seed_resolution;
-  for (const Vertex& m : vertex_memory) {
+  for (Vertex& m : vertex_memory) {
+    m.centroid = motion * m.centroid;
+    m.normal = motion.linear() * m.normal;
     if (m.age + 1 > max_age || !detail::hidden(frame, cMw, m.centroid, tolerance)) continue;
     const bool replaced =
         std::any_of(vertices.begin(), vertices.begin() + static_cast<std::ptrdiff_t>(seen),

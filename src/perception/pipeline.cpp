@@ -140,6 +140,8 @@ void Perception::reset() {
   impl_->memory_chroma.clear();
   impl_->memory_age.clear();
   impl_->vertex_memory.clear();
+  impl_->previous_outline.clear();
+  impl_->previous_outline_normals.clear();
   impl_->initial_voxels = 0;
   impl_->plane.reset();
 }

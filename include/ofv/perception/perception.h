@@ -77,6 +77,20 @@ struct TrackingSettings {
   /// view keeps the whole object clear, not only the part still seen.
   /// false: only the supervoxels seen in the frame (the paper's reading).
   bool hidden_vertices = true;
+  /// The remembered hidden voxels and vertices follow the object's rigid
+  /// motion between consecutive frames, estimated from its visible part: a
+  /// few Gauss-Newton (ICP) steps that align the frame's object voxels with
+  /// the previous frame's, point-to-plane on the surface and, at the
+  /// object's own outline (not where an occluder or the image border cuts
+  /// it), along the outline's normal. So the part hidden behind a static
+  /// occluder stays where the moving object is. Motion along a direction the
+  /// visible part does not constrain (a plain face sliding in its plane with
+  /// no outline seen) is taken as zero, and an estimate beyond max_motion or
+  /// from too little of the object is dropped: a static object does not
+  /// drift. false (default): hidden parts stay where they were last seen.
+  /// Off by default: on the simulator's moving-object scenario it did not
+  /// raise the visible fraction (see docs/perception.md).
+  bool follow_motion = false;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
   /// this distance, normal within 60 degrees) are never object: the table
