@@ -50,7 +50,9 @@ cv::Mat camera_picture(const StepRecord& rec, const StepDetail& d) {
 // A Fig. 6-style view of the scene from a virtual observer beside the camera:
 // object supervoxels and normals (blue), occluders (red), the sphere, C, the
 // real camera and its path (white), t0 (yellow), tf (green) and, where
-// target hysteresis kept another, the target the controller follows (magenta).
+// target hysteresis kept another, the target the controller follows (magenta);
+// each confirmed occluder track as an orange arrow from its position to
+// where it will be in 0.5 s, with its id.
 cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d,
                       const std::vector<Eigen::Vector3d>& path, double r_sphere) {
   const std::optional<ViewEstimate>& estimate = d.step->estimate;
@@ -87,6 +89,12 @@ cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d,
     for (Eigen::Index i = 0; i < d.problem->occluders.cols(); ++i) {
       if (const auto a = p(d.problem->occluders.col(i))) cv::rectangle(img, *a - cv::Point(2, 2), *a + cv::Point(2, 2), {60, 60, 230}, cv::FILLED);
     }
+  }
+  for (const OccluderTrack& t : d.step->tracks) {
+    if (!t.confirmed || t.points.cols() == 0) continue;
+    const auto a = p(t.position), b = p(t.position + 0.5 * t.velocity);
+    if (a && b) cv::arrowedLine(img, *a, *b, {40, 150, 255}, 2, cv::LINE_AA, 0, 0.2);
+    if (a) cv::putText(img, "#" + std::to_string(t.id), *a + cv::Point(6, 12), cv::FONT_HERSHEY_SIMPLEX, 0.4, {40, 150, 255}, 1, cv::LINE_AA);
   }
   for (std::size_t i = 1; i < path.size(); ++i) {
     const auto a = p(path[i - 1]), b = p(path[i]);
