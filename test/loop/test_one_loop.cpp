@@ -52,6 +52,7 @@ std::vector<Command> dry_run_commands(const std::string& out) {
   std::vector<Command> commands;
   std::stringstream in(out);
   for (std::string line; std::getline(in, line);) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const auto j = nlohmann::json::parse(line);
     commands.push_back({j.at("status").get<std::string>(), j.at("v").get<std::vector<double>>()});
   }
