@@ -16,6 +16,9 @@
 #include <visp3/robot/vpRobotAfma6.h>
 #endif
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -76,24 +79,61 @@ std::unique_ptr<CameraRobot> real_robot(const std::string& name, const vpHomogen
   return nullptr;
 }
 
-// One JSON line per command (dry run): frame, time, status, twist (17 digits),
-// safety action, the confirmed occluder tracks seen in the frame (id,
-// position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
-void print_command(long frame, double t, const char* status, const vpColVector& v, const char* safety,
-                   const std::vector<OccluderTrack>& tracks = {}) {
-  std::printf("{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
-  for (unsigned i = 0; i < 6; ++i) std::printf("%s%.17g", i ? ", " : "", v[i]);
-  std::printf("], \"safety\": \"%s\", \"tracks\": [", safety);
-  bool first = true;
-  for (const OccluderTrack& k : tracks) {
-    if (!k.confirmed || k.points.cols() == 0) continue;
-    std::printf("%s{\"id\": %d, \"p\": [%.6g, %.6g, %.6g], \"v\": [%.6g, %.6g, %.6g], \"sigma_v\": %.6g}",
-                first ? "" : ", ", k.id, k.position.x(), k.position.y(), k.position.z(), k.velocity.x(),
-                k.velocity.y(), k.velocity.z(), k.speed_sigma());
-    first = false;
+// A dry run's JSON lines own stdout: while the loop runs, whatever else
+// writes there (ViSP's drivers and threaded simulators print warnings such as
+// "Velocity control stopped: axis 3 on joint limit") goes to stderr instead.
+class CommandLines {
+ public:
+  explicit CommandLines(bool dry_run) {
+    if (!dry_run) return;
+    std::cout.flush();
+    std::fflush(stdout);
+    saved_ = ::dup(STDOUT_FILENO);
+    const int own = saved_ >= 0 ? ::dup(saved_) : -1;
+    out_ = own >= 0 ? ::fdopen(own, "w") : nullptr;
+    if (!out_) throw std::runtime_error("cannot duplicate stdout for the dry run's command lines");
+    ::dup2(STDERR_FILENO, STDOUT_FILENO);
   }
-  std::printf("]}\n");
-}
+  ~CommandLines() { close(); }
+  CommandLines(const CommandLines&) = delete;
+  CommandLines& operator=(const CommandLines&) = delete;
+
+  /// One JSON line per command: frame, time, status, twist (17 digits),
+  /// safety action, the confirmed occluder tracks seen in the frame (id,
+  /// position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
+  void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,
+             const std::vector<OccluderTrack>& tracks = {}) {
+    if (!out_) return;
+    std::fprintf(out_, "{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
+    for (unsigned i = 0; i < 6; ++i) std::fprintf(out_, "%s%.17g", i ? ", " : "", v[i]);
+    std::fprintf(out_, "], \"safety\": \"%s\", \"tracks\": [", safety);
+    bool first = true;
+    for (const OccluderTrack& k : tracks) {
+      if (!k.confirmed || k.points.cols() == 0) continue;
+      std::fprintf(out_, "%s{\"id\": %d, \"p\": [%.6g, %.6g, %.6g], \"v\": [%.6g, %.6g, %.6g], \"sigma_v\": %.6g}",
+                   first ? "" : ", ", k.id, k.position.x(), k.position.y(), k.position.z(), k.velocity.x(),
+                   k.velocity.y(), k.velocity.z(), k.speed_sigma());
+      first = false;
+    }
+    std::fprintf(out_, "]}\n");
+    std::fflush(out_);
+  }
+
+  /// The final stop line, then stdout back to what it was.
+  void close() {
+    if (!out_) return;
+    std::fclose(out_);
+    out_ = nullptr;
+    std::cout.flush();
+    std::fflush(stdout);
+    ::dup2(saved_, STDOUT_FILENO);
+    ::close(saved_);
+  }
+
+ private:
+  std::FILE* out_ = nullptr;
+  int saved_ = -1;
+};
 
 }  // namespace
 
@@ -161,16 +201,16 @@ Command add_run_command(CLI::App& app) {
             }
             std::signal(SIGINT, on_signal);
             std::signal(SIGTERM, on_signal);
-            const auto print = [&](const RobotLoopFrame& f) {
-              if (opt->dry_run) {
-                print_command(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
-                              to_string(f.step->safety), f.step->tracks);
-              }
-            };
             try {
+              CommandLines lines(opt->dry_run);
+              const auto print = [&](const RobotLoopFrame& f) {
+                lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
+                            to_string(f.step->safety), f.step->tracks);
+              };
               if (simulated) {
                 const EpisodeOutcome outcome = rehearse(setup, &g_stop, print);
-                if (opt->dry_run) print_command(outcome.metrics.steps, outcome.metrics.duration, "stop", vpColVector(6, 0.0), "");
+                lines.print(outcome.metrics.steps, outcome.metrics.duration, "stop", vpColVector(6, 0.0), "");
+                lines.close();
                 std::cout << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
                           << (g_stop ? ", stopped" : "") << '\n'
                           << episode_summary(outcome.metrics);
@@ -182,7 +222,8 @@ Command add_run_command(CLI::App& app) {
               options.max_duration = setup.duration;
               options.stop = &g_stop;
               const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
-              if (opt->dry_run) print_command(summary.frames, 0.0, "stop", vpColVector(6, 0.0), "");
+              lines.print(summary.frames, 0.0, "stop", vpColVector(6, 0.0), "");
+              lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
                         << (summary.stopped ? ", stopped by a signal" : "") << '\n';
               return kOk;
