@@ -94,6 +94,16 @@ struct NoFreeViewSettings {
   double step_deg = 8.0;          ///< neighbours of the current view, this far from it seen from C [deg]
   double margin = 0.05;           ///< a view must see this much more of the object than the current one
   double occluder_radius = 0.02;  ///< an occluder point blocks lines of sight passing closer than this [m]
+  /// Retreat (ofv::ViewLoop, told how much of the object each frame shows):
+  /// the loop remembers the camera position that showed the most of the
+  /// object. When the camera has moved away from it and shows this fraction
+  /// of that less, and the frame's occluders (score_view) do not make that
+  /// position worse than the current one, the camera goes back there and
+  /// holds until, back there, it shows this fraction less again (the scene
+  /// changed). A target that only a partial perception believes clear (an
+  /// occluder hidden behind another) so cannot lead the camera into a cage
+  /// that hides the object. 0 = off.
+  double retreat_drop = 0.1;
 };
 
 /**

@@ -39,17 +39,19 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       out.dt = dt;
       out.source_s = std::chrono::duration<double>(arrived - asked).count();
       std::optional<ViewProblem> problem;
+      std::optional<double> shown;
       PerceptionResult result;
       if (options.problem_source) {
         problem = options.problem_source(*frame);
       } else {
         result = perception->process(*frame);
         if (result.status != TrackingStatus::Lost) problem = result.problem;
+        shown = shown_object(result);
         out.perception = &result;
       }
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       out.frame_age = options.wall_clock_age ? out.perception_s : gap;
-      const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age);
+      const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age, shown);
       out.step = &step;
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
       if (options.move_robot) (void)robot.step(step.velocity, dt);

@@ -3,6 +3,7 @@
 
 #include "ofv/estimator_settings.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -149,6 +150,10 @@ SettingsTable<LoopSettings> make_table() {
           l.no_free_view.mode = parse_word<NoFreeView>(
               "no_free_view", v, {{"best_iterate", NoFreeView::BestIterate}, {"most_visible", NoFreeView::MostVisible}});
         });
+  t.add({"retreat_drop", "number", format_number(d.no_free_view.retreat_drop), "",
+         "the fraction of the object the camera may see less, after moving, than at the view it has been at that "
+         "showed the most, before it goes back there and holds (unless the occluders came there too), 0 (off) to 1"},
+        [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); });
   t.add({"no_free_view_margin", "number", format_number(d.no_free_view.margin), "",
          "no_free_view=most_visible: a view must see this fraction more of the object than the current one, 0 to 1"},
         [](L& l, const std::string& v) {
@@ -207,6 +212,49 @@ void ViewLoop::reset() {
   controller_.reset();
   safety_.reset();
   tracker_.reset();
+  best_seen_.reset();
+  held_.reset();
+  low_frames_ = 0;
+}
+
+std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, const ViewEstimate& estimate,
+                                                 double shown, const std::optional<Eigen::Vector3d>& target) {
+  const NoFreeViewSettings& s = settings_.no_free_view;
+  const Eigen::Vector3d& c = estimate.centroid;
+  const Eigen::Vector3d& here = *problem.camera;
+  if (s.retreat_drop <= 0.0) return target;
+  constexpr double kAway = 0.01;  // [m]: the camera has moved from a view
+  constexpr int kFrames = 2;      // a loss counts when it lasts this many frames (one frame is noise)
+  const double keep = 1.0 - s.retreat_drop;
+  if (held_) {
+    const bool there = (here - held_->position).norm() <= kAway;
+    low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
+    if (estimate.iterations > 0 && low_frames_ < kFrames * 8) return held_->position;
+    held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
+    best_seen_ = SeenView{here, shown};
+    low_frames_ = 0;
+    return target;
+  }
+  if (!best_seen_ || shown >= best_seen_->shown) {
+    best_seen_ = SeenView{here, shown};
+    low_frames_ = 0;
+    return target;
+  }
+  const bool away = (here - best_seen_->position).norm() > kAway;
+  low_frames_ = away && shown < keep * best_seen_->shown ? low_frames_ + 1 : 0;
+  if (low_frames_ < kFrames) return target;
+  const double r = estimator_.r_sphere;
+  const auto score = [&](const Eigen::Vector3d& p) {
+    return score_view(problem, c, r, c + r * (p - c).normalized(), s.occluder_radius).visible_fraction;
+  };
+  // The frame's occluders must make that view clearly better, or at least
+  // not worse where they hide most of the object from here.
+  const double here_score = score(here);
+  const double margin = here_score < 0.5 ? 0.0 : 0.1;
+  if (score(best_seen_->position) < here_score + margin) return target;  // the occluders came there too
+  held_ = best_seen_;
+  low_frames_ = 0;
+  return held_->position;
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& problem, const ViewEstimate& estimate) {
@@ -266,7 +314,7 @@ Eigen::Matrix3Xd ViewLoop::predicted(const Eigen::Vector3d& centroid) const {
 }
 
 LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
-                        double frame_age) {
+                        double frame_age, std::optional<double> shown) {
   LoopStep out;
   auto start = Clock::now();
   if (problem) {
@@ -300,6 +348,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
       }
     }
     out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate);
+    if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, *out.estimate, *shown, out.target);
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
   }

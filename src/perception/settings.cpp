@@ -7,6 +7,11 @@
 
 namespace ofv {
 
+std::optional<double> shown_object(const PerceptionResult& result) {
+  if (result.status == TrackingStatus::Lost) return std::nullopt;
+  return static_cast<double>(result.counts.object_voxels);
+}
+
 const char* to_string(TrackingStatus status) {
   switch (status) {
     case TrackingStatus::Initialised:

@@ -117,6 +117,46 @@ TEST(ViewLoop, WithoutAFreeViewItHoldsStill) {
   }
 }
 
+// The camera leaves the origin for the estimator's view (the cluster of
+// patch(true) hides part of the patch from the origin); on its way the frame
+// shows half as much of the object: a cluster that was hidden before now
+// blocks the whole patch (a false free view), or, when `occluders_came_there`,
+// a cluster arrived in front of the origin. Returns the last target.
+Eigen::Vector3d after_a_false_free_view(double retreat_drop, bool occluders_came_there) {
+  LoopSettings settings;
+  settings.no_free_view.retreat_drop = retreat_drop;
+  ViewLoop loop(settings);
+  const double dt = 1.0 / 30.0;
+  LoopStep s = loop.step(patch(true), vpHomogeneousMatrix(), dt, 0.0, /*shown=*/100.0);
+  EXPECT_TRUE(s.target);
+  const Eigen::Vector3d away = *s.target;
+  EXPECT_GT(away.norm(), 0.05);
+  for (int k = 1; k <= 3; ++k) {
+    const Eigen::Vector3d camera = away * 0.1 * k;  // on its way
+    const Eigen::Vector3d cluster = occluders_came_there ? Eigen::Vector3d(0, 0, 0.02)  // in front of the origin
+                                                         : 0.5 * (camera + Eigen::Vector3d(0, 0, 0.5));
+    ViewProblem p = patch(true);
+    p.occluders.conservativeResize(3, 9 + 49);
+    const double spacing = occluders_came_there ? 0.002 : 0.01;
+    for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = cluster + spacing * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
+    s = loop.step(p, vpHomogeneousMatrix(vpTranslationVector(camera.x(), camera.y(), camera.z()), vpRotationMatrix()),
+                  dt, 0.0, /*shown=*/50.0);
+    EXPECT_TRUE(s.target);
+  }
+  return s.target.value_or(Eigen::Vector3d::Constant(NAN));
+}
+
+TEST(ViewLoop, RetreatsWhenItsOwnMotionHidesTheObject) {
+  // Shown halved two frames in a row, 1 cm or more from the view that showed
+  // the most (the origin), which the frame's occluders do not make worse
+  // than here: back to the origin, and hold.
+  EXPECT_LT(after_a_false_free_view(0.2, false).norm(), 1e-12);
+  // Off, or the occluders came to the origin too (the scene changed): the
+  // estimator's view.
+  EXPECT_GT(after_a_false_free_view(0.0, false).norm(), 0.05);
+  EXPECT_GT(after_a_false_free_view(0.2, true).norm(), 0.05);
+}
+
 TEST(ViewLoop, SettingsByNameAreValidated) {
   LoopSettings s;
   loop_settings_table().set(s, "max_linear_speed", "0.3");

@@ -214,6 +214,10 @@ struct PerceptionResult {
   std::string message;  ///< why the object is lost, when it is
 };
 
+/// \brief How much of the object the frame shows: its voxels seen in the
+///        frame (ofv::ViewLoop::step's `shown`); std::nullopt when the object is lost.
+[[nodiscard]] std::optional<double> shown_object(const PerceptionResult& result);
+
 [[nodiscard]] const char* to_string(TrackingStatus status);
 [[nodiscard]] const char* to_string(SupervoxelClass label);
 

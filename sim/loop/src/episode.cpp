@@ -145,8 +145,10 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 
     start = Clock::now();
     std::optional<ViewProblem> problem;
+    std::optional<double> shown = rec.visible_fraction;  // ground truth: what the camera sees
     if (perception) {
       PerceptionResult result = perception->process(rendered.frame);
+      shown = shown_object(result);
       if (result.status != TrackingStatus::Lost) problem = std::move(result.problem);
     } else {
       problem = std::move(gt_problem);
@@ -154,7 +156,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     rec.times.perception = seconds_since(start);
 
     // The frame is as old as 1 + latency periods when its command is replaced.
-    const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency));
+    const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency), shown);
     record_step(rec, step);
 
     outcome.steps.push_back(rec);

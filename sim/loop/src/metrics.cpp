@@ -135,6 +135,7 @@ std::string episode_summary(const EpisodeMetrics& m) {
       << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
       << "  compute per step: " << 1e3 * m.mean_times.total() << " ms (render " << 1e3 * m.mean_times.render
       << ", perception " << 1e3 * m.mean_times.perception << ", estimate " << 1e3 * m.mean_times.estimate
+      << " (worst " << 1e3 * m.max_times.estimate << ")"
       << ", control " << 1e3 * m.mean_times.control << ")\n";
   return out.str();
 }

@@ -57,6 +57,7 @@ const std::vector<MetricColumn>& metric_columns() {
       {"path_length_m", "path [m]", [](const EpisodeMetrics& m) { return m.path_length; }},
       {"max_sphere_distance_error_m", "max sphere dist. err. [m]", [](const EpisodeMetrics& m) { return m.max_sphere_distance_error; }},
       {"mean_estimate_ms", "estimate [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.mean_times.estimate; }},
+      {"max_estimate_ms", "worst estimate [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.max_times.estimate; }},
       {"mean_step_ms", "whole step [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.mean_times.total(); }},
   };
   return c;

@@ -134,9 +134,14 @@ class ViewLoop {
    *                  will be applied for [s].
    * \param frame_age how old the frame is when the command is sent [s]
    *                  (older than the stale timeout: stop).
+   * \param shown     how much of the object the frame shows, in any unit
+   *                  that does not depend on the view (perception:
+   *                  ofv::shown_object(), its voxels seen in the frame), or
+   *                  std::nullopt when unknown: then the loop never
+   *                  retreats (NoFreeViewSettings::retreat_drop).
    */
   [[nodiscard]] LoopStep step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
-                              double frame_age);
+                              double frame_age, std::optional<double> shown = std::nullopt);
 
   /// \brief Forgets the previous view, target and command (a new run).
   void reset();
@@ -148,6 +153,14 @@ class ViewLoop {
  private:
   [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate);
   [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
+  [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, const ViewEstimate& estimate,
+                                                       double shown, const std::optional<Eigen::Vector3d>& target);
+
+  /// A camera position (world) and how much of the object it showed.
+  struct SeenView {
+    Eigen::Vector3d position;
+    double shown = 0.0;
+  };
 
   LoopSettings settings_;
   EstimatorSettings estimator_;
@@ -155,6 +168,9 @@ class ViewLoop {
   SafetyFilter safety_;
   OccluderTracker tracker_;
   std::optional<Eigen::Vector3d> previous_view_, previous_target_;
+  std::optional<SeenView> best_seen_;  ///< the view that showed the most of the object
+  std::optional<SeenView> held_;       ///< retreated there: hold
+  int low_frames_ = 0;                 ///< frames in a row showing much less than best_seen_ or held_
 };
 
 }  // namespace ofv
