@@ -26,9 +26,26 @@ std::string EpisodeSpec::id() const {
   return safe_name(scenario) + "__" + safe_name(variant.name) + "__seed" + std::to_string(seed);
 }
 
+void check_sweep_size(std::size_t scenarios, std::size_t variants, int seeds) {
+  const std::string what = std::to_string(scenarios) + " scenarios x " + std::to_string(variants) +
+                           " variants x " + std::to_string(seeds) + " seeds";
+  if (seeds < 1 || seeds > kMaxSeeds) {
+    throw std::invalid_argument("seeds: expected an integer in 1.." + std::to_string(kMaxSeeds) + ", got " +
+                                std::to_string(seeds));
+  }
+  if (scenarios == 0 || variants == 0) throw std::invalid_argument(what + ": nothing to run");
+  // Overflow-safe: a * b > max exactly when b > max / a (integers, a > 0).
+  const auto s = static_cast<std::size_t>(seeds);
+  if (variants > kMaxEpisodes / scenarios || s > kMaxEpisodes / (scenarios * variants)) {
+    throw std::invalid_argument(what + ": more than " + std::to_string(kMaxEpisodes) + " episodes");
+  }
+}
+
 std::vector<EpisodeSpec> plan_episodes(
     const std::vector<std::pair<std::string, std::string>>& scenarios, const Grid& grid) {
+  check_sweep_size(scenarios.size(), grid.variants.size(), grid.seeds);
   std::vector<EpisodeSpec> out;
+  out.reserve(scenarios.size() * grid.variants.size() * static_cast<std::size_t>(grid.seeds));
   for (const auto& [name, path] : scenarios) {
     for (const Variant& v : grid.variants) {
       for (int seed = 0; seed < grid.seeds; ++seed) {
@@ -69,9 +86,9 @@ std::vector<EpisodeSpec> shard(const std::vector<EpisodeSpec>& all, int k, int n
 
 int run_sweep(const std::vector<EpisodeSpec>& episodes, const EpisodeRunner& runner,
               const std::string& out_dir, const SweepOptions& options) {
-  if (options.jobs < 0) {
-    throw std::invalid_argument("jobs must be >= 0 (0: one per core), got " +
-                                std::to_string(options.jobs));
+  if (options.jobs < 0 || options.jobs > kMaxJobs) {
+    throw std::invalid_argument("jobs: expected an integer in 0.." + std::to_string(kMaxJobs) +
+                                " (0: one per core), got " + std::to_string(options.jobs));
   }
   const EpisodeStore store(out_dir);
   std::vector<const EpisodeSpec*> todo;

@@ -35,7 +35,17 @@ struct EpisodeSpec {
 ///        `.` replaced by `_`, for use in file names.
 [[nodiscard]] std::string safe_name(const std::string& text);
 
+/// \brief The most episodes run in parallel (`--jobs`).
+inline constexpr int kMaxJobs = 256;
+
+/// \brief Checks the size of a sweep before it is planned: 1..kMaxSeeds
+///        seeds, at least one scenario and variant, and at most kMaxEpisodes
+///        episodes (computed without overflow).
+/// \throws std::invalid_argument giving the counts.
+void check_sweep_size(std::size_t scenarios, std::size_t variants, int seeds);
+
 /// \brief Every scenario x variant x seed, in a fixed order.
+/// \throws std::invalid_argument from check_sweep_size(), before anything is allocated.
 [[nodiscard]] std::vector<EpisodeSpec> plan_episodes(
     const std::vector<std::pair<std::string, std::string>>& scenarios,  // name, path
     const Grid& grid);
@@ -65,7 +75,7 @@ using EpisodeRunner = std::function<EpisodeOutcome(const EpisodeSpec&)>;
 
 /// \brief Options of run_sweep().
 struct SweepOptions {
-  int jobs = 1;           ///< episodes in parallel; 0: one per core
+  int jobs = 1;           ///< episodes in parallel, 0..kMaxJobs; 0: one per core
   bool progress = false;  ///< progress bar with ETA on stderr (when it is a terminal)
 };
 
@@ -79,7 +89,7 @@ struct SweepOptions {
  * \return the number of episodes run (not resumed).
  * \throws std::runtime_error if an episode fails (its message names the
  *         episode); episodes not yet started are then skipped.
- * \throws std::invalid_argument if `options.jobs` is negative.
+ * \throws std::invalid_argument if `options.jobs` is outside 0..kMaxJobs.
  */
 int run_sweep(const std::vector<EpisodeSpec>& episodes, const EpisodeRunner& runner,
               const std::string& out_dir, const SweepOptions& options);
