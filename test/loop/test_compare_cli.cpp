@@ -95,5 +95,70 @@ TEST_F(SweepCli, TwoScenariosOfTheSameNameExitTwo) {
                      {"b/x.yaml", "'x'", "a/x.yaml"});
 }
 
+
+// Lines of a file, the header included.
+std::size_t lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+TEST_F(SweepCli, LookAlikeVariantNamesAreRowsOfTheirOwn) {
+  const std::string grid = sh(write("g.yaml", kShort + "seeds: 1\nvariants:\n  - {name: a/b, set: {gain: 1}}\n"
+                                                       "  - {name: a_b, set: {gain: 2}}\n"
+                                                       "  - {name: a__seed0, set: {gain: 3}}\n").string());
+  const CommandRun r = run("compare --scenarios dvd-one-hand --grid " + grid + " --jobs 2 --out " + sh((dir_ / "o").string()));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 episodes (3 run, 0 resumed)"), std::string::npos) << r.out;
+  EXPECT_EQ(lines(dir_ / "o" / "episodes.csv"), 4U);
+  EXPECT_EQ(lines(dir_ / "o" / "summary.csv"), 4U);
+}
+
+TEST_F(SweepCli, ResumeRunsTheRestAndRefusesAnotherGridsFolder) {
+  const std::string g1 = sh(write("g1.yaml", kShort + "seeds: 1\nvariants:\n  - {name: fast, set: {gain: 2}}\n").string());
+  const std::string g2 = sh(write("g2.yaml", kShort + "seeds: 1\nvariants:\n  - {name: fast, set: {gain: 3}}\n").string());
+  const std::string out = " --out " + sh((dir_ / "o").string());
+  ASSERT_EQ(run("compare --scenarios dvd-one-hand --grid " + g1 + out).code, 0);
+  const CommandRun again = run("compare --scenarios dvd-one-hand --grid " + g1 + out);
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("(0 run, 1 resumed)"), std::string::npos) << again.out;
+  expect_usage_error("--scenarios dvd-one-hand --grid " + g2 + out, {"sweep.json", "fast", "gain=2", "gain=3"});
+  expect_usage_error("--scenarios dvd-one-hand --grid " + g1 + " --seeds 2" + out, {"sweep.json", "seeds"});
+}
+
+TEST_F(SweepCli, MergeRefusesOtherSweepsAndConflictsAndNamesWhatIsMissing) {
+  const std::string g1 = sh(write("g1.yaml", kShort + "seeds: 2\nvariants:\n  - {name: fast, set: {gain: 2}}\n").string());
+  const std::string g2 = sh(write("g2.yaml", kShort + "seeds: 2\nvariants:\n  - {name: fast, set: {gain: 3}}\n").string());
+  auto part = [&](const std::string& grid, const std::string& shard, const std::string& name) {
+    const CommandRun r = run("compare --scenarios dvd-one-hand --grid " + grid + " --jobs 1 --shard " + shard +
+                             " --out " + sh((dir_ / name).string()));
+    EXPECT_EQ(r.code, 0) << r.err;
+    return sh((dir_ / name).string());
+  };
+  const std::string p1 = part(g1, "1/2", "p1"), p2 = part(g1, "2/2", "p2"), q2 = part(g2, "2/2", "q2");
+  const std::string whole = part(g1, "1/1", "whole");
+  const CommandRun ok = run("compare --merge " + p1 + " " + p2 + " --out " + sh((dir_ / "m").string()));
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(lines(dir_ / "m" / "episodes.csv"), 3U);
+  // Parts of two grids.
+  expect_usage_error("--merge " + p1 + " " + q2 + " --out " + sh((dir_ / "m2").string()),
+                     {(dir_ / "p1" / "sweep.json").string(), (dir_ / "q2" / "sweep.json").string(), "gain=3"});
+  // The same episode run twice (part 1/2 and the whole sweep), with other results.
+  expect_usage_error("--merge " + p1 + " " + whole + " --out " + sh((dir_ / "m3").string()),
+                     {(dir_ / "p1" / "episodes").string(), (dir_ / "whole" / "episodes").string(), "different results"});
+  EXPECT_FALSE(fs::exists(dir_ / "m2"));
+  EXPECT_FALSE(fs::exists(dir_ / "m3"));
+  // Part 2 not given: its episode is named, the tables hold the others, exit 1.
+  const CommandRun partial = run("compare --merge " + p1 + " --out " + sh((dir_ / "m4").string()));
+  EXPECT_EQ(partial.code, 1) << partial.err;
+  EXPECT_EQ(std::count(partial.err.begin(), partial.err.end(), '\n'), 1) << partial.err;
+  EXPECT_NE(partial.err.find("1 of 2 episodes are missing"), std::string::npos) << partial.err;
+  EXPECT_NE(partial.err.find("dvd-one-hand__fast__seed1__"), std::string::npos) << partial.err;
+  EXPECT_NE(partial.err.find("missing.csv"), std::string::npos) << partial.err;
+  EXPECT_EQ(lines(dir_ / "m4" / "episodes.csv"), 2U);
+  EXPECT_EQ(lines(dir_ / "m4" / "missing.csv"), 2U);
+}
+
 }  // namespace
 }  // namespace ofv
