@@ -349,5 +349,24 @@ TEST_F(SweepFiles, MergeNamesTheMissingEpisodes) {
   }
 }
 
+
+TEST_F(SweepFiles, PlotsRunNoShellAndQuoteEveryName) {
+  // An output folder, a scenario and a variant whose names would run
+  // commands if pasted into a shell or into the gnuplot script unquoted.
+  const fs::path marker = dir_ / "marker";
+  const std::string touch = "touch " + marker.string();
+  const fs::path out = dir_ / ("o'$(" + touch + ")'\";" + touch + ";\"`" + touch + "`");
+  Grid grid = grid_from_yaml("seeds: 1\naxes: {gain: [1, 2]}\n", "g.yaml");
+  grid.variants[1].name = "v'\nsystem '" + touch + "'\n'";
+  const auto all = plan_episodes({{"s' . system('" + touch + "') . '", "s.yaml"}}, grid);
+  run_sweep(all, synthetic, out.string(), {1, false, {}});
+  const auto pngs = write_reports(load_episodes({out.string()}), out.string());
+  EXPECT_FALSE(fs::exists(marker)) << "a name ran a command";
+  ASSERT_EQ(pngs.size(), 5U) << "gnuplot failed: " << slurp(out / "plots" / "gnuplot.log");
+  for (const auto& p : pngs) EXPECT_GT(fs::file_size(p), 1000U) << p;
+  // The script names only files of the plots folder.
+  EXPECT_EQ(slurp(out / "plots" / "plots.gp").find((dir_ / "o").string()), std::string::npos);
+}
+
 }  // namespace
 }  // namespace ofv

@@ -160,5 +160,15 @@ TEST_F(SweepCli, MergeRefusesOtherSweepsAndConflictsAndNamesWhatIsMissing) {
   EXPECT_EQ(lines(dir_ / "m4" / "missing.csv"), 2U);
 }
 
+
+TEST_F(SweepCli, SimulateOutIsNeverPastedIntoAShell) {
+  const fs::path marker = dir_ / "marker";
+  const fs::path out = dir_ / ("o'$(touch " + marker.string() + ")'\"`touch " + marker.string() + "`\"");
+  const CommandRun r = run("simulate dvd-one-hand --set duration=0.2 --set perception=ground-truth --out " + sh(out.string()));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(marker)) << "--out ran a command";
+  EXPECT_GT(fs::file_size(out / "visibility.png"), 1000U);
+}
+
 }  // namespace
 }  // namespace ofv
