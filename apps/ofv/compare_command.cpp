@@ -53,8 +53,9 @@ Command add_compare_command(CLI::App& app) {
             Shard part;
             try {
               if (!opt->merge.empty()) {
-                if (!opt->scenarios.empty() || !opt->grid.empty()) {
-                  throw std::invalid_argument("--merge takes no --scenarios or --grid");
+                if (!opt->scenarios.empty() || !opt->grid.empty() || seeds->count() > 0 || jobs->count() > 0 ||
+                    !opt->shard.empty()) {
+                  throw std::invalid_argument("--merge takes no --scenarios, --grid, --seeds, --jobs or --shard");
                 }
                 merged = read_sweep(opt->merge);
               } else {

@@ -147,6 +147,7 @@ TEST_F(SweepCli, MergeRefusesOtherSweepsAndConflictsAndNamesWhatIsMissing) {
   // The same episode run twice (part 1/2 and the whole sweep), with other results.
   expect_usage_error("--merge " + p1 + " " + whole + " --out " + sh((dir_ / "m3").string()),
                      {(dir_ / "p1" / "episodes").string(), (dir_ / "whole" / "episodes").string(), "different results"});
+  expect_usage_error("--merge " + p1 + " " + p2 + " --jobs 2 --out " + sh((dir_ / "m2").string()), {"--merge", "--jobs"});
   EXPECT_FALSE(fs::exists(dir_ / "m2"));
   EXPECT_FALSE(fs::exists(dir_ / "m3"));
   // Part 2 not given: its episode is named, the tables hold the others, exit 1.
