@@ -6,10 +6,13 @@
 #include "ofv/loop/episode.h"
 #include "ofv/loop/scenario_set.h"
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
 namespace ofv::cli {
+
+namespace fs = std::filesystem;
 
 Command add_compare_command(CLI::App& app) {
   struct Options {
@@ -26,38 +29,60 @@ Command add_compare_command(CLI::App& app) {
   sub->add_option("--scenarios", opt->scenarios, "Scenario files, folders of them, or built-in names");
   sub->add_option("--grid", opt->grid, "Settings grid (YAML, see docs/compare.md)");
   sub->add_option("--out", opt->out, "Output folder")->required();
-  sub->add_option("--seeds", opt->seeds, "Seeds per scenario x variant (default: the grid's)");
-  sub->add_option("--jobs", opt->jobs, "Episodes in parallel (default: all cores)");
+  CLI::Option* seeds = sub->add_option("--seeds", opt->seeds, "Seeds per scenario x variant, 1..1000 (default: the grid's)");
+  CLI::Option* jobs = sub->add_option("--jobs", opt->jobs, "Episodes in parallel, 1..256 (default: one per core)");
   sub->add_option("--shard", opt->shard, "Run part K of N of the sweep (K/N, 1-based)");
-  sub->add_option("--merge", opt->merge, "Merge the outputs of these runs (shards) into --out");
-  sub->footer("Writes episodes/ (one .json + .csv per finished episode; a run resumes from them), "
-              "episodes.csv, summary.csv, summary.md and plots/*.png.");
+  sub->add_option("--merge", opt->merge, "Merge the outputs of these runs (shards of one sweep) into --out");
+  sub->footer(
+      "Writes sweep.json (the whole sweep and the part run into this folder), episodes/ (one .json + .csv\n"
+      "per finished episode, named <scenario>__<variant>__seed<k>__<fingerprint>), episodes.csv,\n"
+      "summary.csv, summary.md and plots/*.png.\n"
+      "Resume: run the same command again; finished episodes are kept. A folder holds one part of one\n"
+      "sweep: another grid, scenario set, seed count or shard, or an episode file recording other\n"
+      "settings, is an error (exit 2, naming the file and what differs), never reused or overwritten.\n"
+      "Merge: the folders must be parts of one sweep (else exit 2, naming both sweep.json); an episode\n"
+      "found in two folders with different results is an error (exit 2, naming both files). Episodes\n"
+      "finished in no folder are listed on stderr and in OUT/missing.csv; the tables of the others are\n"
+      "written and the exit status is 1.\n"
+      "Limits: --seeds 1..1000, --jobs 1..256, at most 100000 episodes per sweep.");
 
-  return {sub, [opt]() -> int {
+  return {sub, [opt, seeds, jobs]() -> int {
             // Usage errors (exit 2) are all found before anything runs or is written.
-            std::vector<EpisodeRow> merged;
-            std::vector<EpisodeSpec> episodes;
+            SweepEpisodes merged;
+            std::vector<EpisodeSpec> episodes;  // the whole sweep
+            Shard part;
             try {
               if (!opt->merge.empty()) {
-                if (!opt->scenarios.empty() || !opt->grid.empty()) {
-                  throw std::invalid_argument("--merge takes no --scenarios or --grid");
+                if (!opt->scenarios.empty() || !opt->grid.empty() || seeds->count() > 0 || jobs->count() > 0 ||
+                    !opt->shard.empty()) {
+                  throw std::invalid_argument("--merge takes no --scenarios, --grid, --seeds, --jobs or --shard");
                 }
-                merged = load_episodes(opt->merge);
+                merged = read_sweep(opt->merge);
               } else {
                 if (opt->scenarios.empty() || opt->grid.empty()) {
                   throw std::invalid_argument("--scenarios and --grid are required (or --merge DIRS)");
                 }
+                if (jobs->count() > 0 && (opt->jobs < 1 || opt->jobs > kMaxJobs)) {
+                  throw std::invalid_argument("--jobs: expected an integer in 1.." + std::to_string(kMaxJobs) +
+                                              ", got " + std::to_string(opt->jobs));
+                }
+                if (seeds->count() > 0 && (opt->seeds < 1 || opt->seeds > kMaxSeeds)) {
+                  throw std::invalid_argument("--seeds: expected an integer in 1.." + std::to_string(kMaxSeeds) +
+                                              ", got " + std::to_string(opt->seeds));
+                }
                 Grid grid = read_grid(opt->grid);
-                if (opt->seeds < 0) throw std::invalid_argument("--seeds must be >= 1");
-                if (opt->seeds > 0) grid.seeds = opt->seeds;
+                if (seeds->count() > 0) grid.seeds = opt->seeds;
                 const auto scenarios = scenario_set(opt->scenarios);
+                try {
+                  check_sweep_size(scenarios.size(), grid.variants.size(), grid.seeds);
+                } catch (const std::invalid_argument& e) {
+                  throw std::invalid_argument(opt->grid + (seeds->count() > 0 ? " with --seeds: " : ": ") +
+                                              e.what());
+                }
                 check_grid(scenarios, grid, opt->grid);
                 episodes = plan_episodes(scenarios, grid);
-                if (!opt->shard.empty()) {
-                  const Shard part = parse_shard(opt->shard);
-                  episodes = shard(episodes, part.k, part.n);
-                }
-                if (opt->jobs < 0) throw std::invalid_argument("--jobs must be >= 1");
+                if (!opt->shard.empty()) part = parse_shard(opt->shard);
+                (void)shard(episodes, part.k, part.n);  // checks K/N
               }
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv compare: " << e.what() << '\n';
@@ -65,19 +90,47 @@ Command add_compare_command(CLI::App& app) {
             }
             try {
               if (!opt->merge.empty()) {
-                const auto plots = write_reports(merged, opt->out);
-                std::cout << "ofv compare: merged " << merged.size() << " episodes from " << opt->merge.size()
-                          << " runs into " << opt->out << "/summary.md (" << plots.size() << " plots)\n";
-                return kOk;
+                const auto plots = write_reports(merged.rows, opt->out);
+                const fs::path missing_file = fs::path(opt->out) / "missing.csv";
+                std::error_code ignored;
+                fs::remove(missing_file, ignored);  // from an earlier merge into this folder
+                std::cout << "ofv compare: merged " << merged.rows.size() << " of " << merged.planned
+                          << " episodes from " << opt->merge.size() << " runs into " << opt->out
+                          << "/summary.md (" << plots.size() << " plots)\n";
+                if (merged.missing.empty()) return kOk;
+                // An unfinished part: the tables of the others are written,
+                // the missing episodes listed, and the exit status says so.
+                std::string csv = "scenario,variant,seed,index,id\n";
+                std::string some;
+                for (const auto& m : merged.missing) {
+                  csv += csv_field(m.scenario) + "," + csv_field(m.variant.name) + "," + std::to_string(m.seed) + "," +
+                         std::to_string(m.index) + "," + m.id() + "\n";
+                  if (some.size() < 200) some += (some.empty() ? "" : ", ") + m.id();
+                }
+                write_file_atomically(missing_file, csv);
+                std::cerr << "ofv compare: --merge: " << merged.missing.size() << " of " << merged.planned
+                          << " episodes are missing (" << some
+                          << (merged.missing.size() > 1 && some.size() >= 200 ? ", ..." : "") << "; all in "
+                          << missing_file.string() << "): the tables hold the others\n";
+                return kRuntimeFailure;
               }
               SweepOptions options;
-              options.jobs = opt->jobs;  // 0: one per core
+              options.jobs = jobs->count() > 0 ? opt->jobs : 0;  // 0: one per core
               options.progress = true;   // drawn only on a terminal
-              const int ran = run_sweep(episodes, simulation_runner(), opt->out, options);
+              options.part = part;
+              const std::size_t mine = shard(episodes, part.k, part.n).size();
+              int ran = 0;
+              try {
+                ran = run_sweep(episodes, simulation_runner(), opt->out, options);
+              } catch (const std::invalid_argument& e) {
+                // The output folder holds another sweep: found before anything ran.
+                std::cerr << "ofv compare: " << e.what() << '\n';
+                return kUsage;
+              }
               const auto rows = load_episodes({opt->out});
               const auto plots = write_reports(rows, opt->out);
-              std::cout << "ofv compare: " << episodes.size() << " episodes (" << ran << " run, "
-                        << episodes.size() - static_cast<std::size_t>(ran) << " resumed); tables in " << opt->out
+              std::cout << "ofv compare: " << mine << " episodes (" << ran << " run, "
+                        << mine - static_cast<std::size_t>(ran) << " resumed); tables in " << opt->out
                         << "/summary.md, " << plots.size() << " plots in " << opt->out << "/plots\n";
               return kOk;
             } catch (const std::exception& e) {

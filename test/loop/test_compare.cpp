@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include <unistd.h>
@@ -89,8 +90,8 @@ TEST(Sweep, ShardTextIsKOverN) {
 }
 
 TEST_F(Compare, ResultsDoNotDependOnTheJobCount) {
-  run_sweep(plan(), synthetic, (dir_ / "one").string(), {1, false});
-  run_sweep(plan(), synthetic, (dir_ / "two").string(), {4, false});
+  run_sweep(plan(), synthetic, (dir_ / "one").string(), {1, false, {}});
+  run_sweep(plan(), synthetic, (dir_ / "two").string(), {4, false, {}});
   write_reports(load_episodes({(dir_ / "one").string()}), (dir_ / "one").string());
   write_reports(load_episodes({(dir_ / "two").string()}), (dir_ / "two").string());
   EXPECT_EQ(slurp(dir_ / "one" / "episodes.csv"), slurp(dir_ / "two" / "episodes.csv"));
@@ -98,11 +99,11 @@ TEST_F(Compare, ResultsDoNotDependOnTheJobCount) {
 }
 
 TEST_F(Compare, ShardsMergedEqualTheWholeSweep) {
-  run_sweep(plan(), synthetic, (dir_ / "whole").string(), {2, false});
+  run_sweep(plan(), synthetic, (dir_ / "whole").string(), {2, false, {}});
   std::vector<std::string> parts;
   for (int k = 1; k <= 3; ++k) {
     parts.push_back((dir_ / ("part" + std::to_string(k))).string());
-    run_sweep(shard(plan(), k, 3), synthetic, parts.back(), {1, false});
+    run_sweep(plan(), synthetic, parts.back(), {1, false, {k, 3}});
   }
   write_reports(load_episodes({(dir_ / "whole").string()}), (dir_ / "whole").string());
   write_reports(load_episodes(parts), (dir_ / "merged").string());
@@ -118,14 +119,14 @@ TEST_F(Compare, AnInterruptedSweepResumes) {
     if (++calls > 5) throw std::runtime_error("killed");
     return synthetic(s);
   };
-  EXPECT_THROW(run_sweep(all, dies, dir_.string(), {1, false}), std::runtime_error);
+  EXPECT_THROW(run_sweep(all, dies, dir_.string(), {1, false, {}}), std::runtime_error);
   EXPECT_EQ(load_episodes({dir_.string()}).size(), 5U);
   int reruns = 0;
   const EpisodeRunner counts = [&](const EpisodeSpec& s) {
     ++reruns;
     return synthetic(s);
   };
-  EXPECT_EQ(run_sweep(all, counts, dir_.string(), {2, false}), static_cast<int>(all.size()) - 5);
+  EXPECT_EQ(run_sweep(all, counts, dir_.string(), {2, false, {}}), static_cast<int>(all.size()) - 5);
   EXPECT_EQ(reruns, static_cast<int>(all.size()) - 5);
   EXPECT_EQ(load_episodes({dir_.string()}).size(), all.size());
 }
@@ -138,7 +139,7 @@ TEST_F(Compare, AFailedEpisodeIsNamedAndTheOthersAreKept) {
     return synthetic(s);
   };
   try {
-    run_sweep(all, fails, dir_.string(), {2, false});
+    run_sweep(all, fails, dir_.string(), {2, false, {}});
     ADD_FAILURE() << "the failure was not reported";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(failing), std::string::npos) << e.what();
@@ -147,12 +148,12 @@ TEST_F(Compare, AFailedEpisodeIsNamedAndTheOthersAreKept) {
   // Whatever finished is on disk, and a rerun completes the sweep.
   const std::size_t kept = load_episodes({dir_.string()}).size();
   EXPECT_LT(kept, all.size());
-  EXPECT_EQ(run_sweep(all, synthetic, dir_.string(), {0, false}), static_cast<int>(all.size() - kept));
+  EXPECT_EQ(run_sweep(all, synthetic, dir_.string(), {0, false, {}}), static_cast<int>(all.size() - kept));
   EXPECT_EQ(load_episodes({dir_.string()}).size(), all.size());
 }
 
 TEST_F(Compare, ReportsAggregateOverSeeds) {
-  run_sweep(plan(), synthetic, dir_.string(), {2, false});
+  run_sweep(plan(), synthetic, dir_.string(), {2, false, {}});
   const auto rows = load_episodes({dir_.string()});
   const auto pngs = write_reports(rows, dir_.string());
   const std::string summary = slurp(dir_ / "summary.csv");
@@ -166,6 +167,205 @@ TEST_F(Compare, ReportsAggregateOverSeeds) {
   for (const auto& p : pngs) {
     EXPECT_GT(fs::file_size(p), 1000U) << p;
   }
+}
+
+
+// The episode files, resume and merge: a folder holds one part of one sweep.
+class SweepFiles : public Compare {
+ protected:
+  static std::vector<EpisodeSpec> plan_of(const std::string& yaml) {
+    return plan_episodes({{"one", "one.yaml"}, {"two", "two.yaml"}}, grid_from_yaml(yaml, "g.yaml"));
+  }
+  static std::size_t json_files(const fs::path& dir) {
+    std::size_t n = 0;
+    for (const auto& e : fs::directory_iterator(dir / "episodes")) n += e.path().extension() == ".json";
+    return n;
+  }
+  // Runs and expects std::invalid_argument before any episode runs; returns its message.
+  static std::string refused(const std::vector<EpisodeSpec>& plan, const fs::path& dir, Shard part = {}) {
+    int runs = 0;
+    const EpisodeRunner counts = [&](const EpisodeSpec& s) {
+      ++runs;
+      return synthetic(s);
+    };
+    try {
+      run_sweep(plan, counts, dir.string(), {1, false, part});
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(runs, 0) << "episodes ran before the error";
+      return e.what();
+    }
+    return {};
+  }
+  static std::string contains(const std::string& text, const std::vector<std::string>& parts) {
+    for (const auto& p : parts) {
+      if (text.find(p) == std::string::npos) return "'" + p + "' not in: " + text;
+    }
+    return {};
+  }
+};
+
+TEST_F(SweepFiles, NamesThatLookAlikeInFileNamesKeepTheirOwnEpisodes) {
+  // `a/b` and `a_b` are one file-name-safe text, `x__seed0` contains the
+  // separator; each variant must run and be its own row.
+  const auto plan = plan_of(R"(seeds: 2
+variants:
+  - {name: a/b, set: {gain: 1}}
+  - {name: a_b, set: {gain: 2}}
+  - {name: a b, set: {gain: 3}}
+  - {name: x__seed0, set: {gain: 4}}
+  - {name: x, set: {gain: 5}}
+)");
+  std::set<std::string> ids;
+  for (const auto& e : plan) ids.insert(e.id());
+  EXPECT_EQ(ids.size(), plan.size());
+  EXPECT_EQ(run_sweep(plan, synthetic, dir_.string(), {2, false, {}}), static_cast<int>(plan.size()));
+  EXPECT_EQ(json_files(dir_), plan.size());
+  const auto rows = load_episodes({dir_.string()});
+  ASSERT_EQ(rows.size(), plan.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].spec.identity(), plan[i].identity());
+    EXPECT_EQ(rows[i].spec.variant.settings, plan[i].variant.settings);
+  }
+  // The file records the identity: scenario, variant, settings and seed.
+  const std::string json = slurp(dir_ / "episodes" / (plan[0].id() + ".json"));
+  for (const char* field : {"\"scenario\"", "\"variant\": \"a/b\"", "\"gain\"", "\"seed\""}) {
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+  }
+  // Ids are readable, stable and short enough for any file system.
+  EXPECT_EQ(plan[0].id().rfind("one__a_b__seed0__", 0), 0U) << plan[0].id();
+  EpisodeSpec long_name = plan[0];
+  long_name.variant.name = std::string(1000, 'v');
+  EXPECT_LT(long_name.id().size() + 9, 255U);
+}
+
+TEST_F(SweepFiles, ResumingIntoTheFolderOfAnotherGridIsAnError) {
+  run_sweep(plan_of("seeds: 2\nvariants:\n  - {name: fast, set: {gain: 2}}\n  - {name: slow, set: {gain: 0.5}}\n"),
+            synthetic, dir_.string(), {1, false, {}});
+  const std::string before = slurp(dir_ / "sweep.json");
+  // Same names, other settings: the old episodes must not pass for the new ones.
+  std::string e = refused(plan_of("seeds: 2\nvariants:\n  - {name: fast, set: {gain: 3}}\n  - {name: slow, set: {gain: 0.5}}\n"), dir_);
+  EXPECT_EQ(contains(e, {"sweep.json", "fast", "gain=2", "gain=3"}), "");
+  // Other variants, seeds or scenarios.
+  e = refused(plan_of("seeds: 2\nvariants:\n  - {name: quick, set: {gain: 2}}\n"), dir_);
+  EXPECT_EQ(contains(e, {"sweep.json", "variants", "quick"}), "");
+  e = refused(plan_of("seeds: 3\nvariants:\n  - {name: fast, set: {gain: 2}}\n  - {name: slow, set: {gain: 0.5}}\n"), dir_);
+  EXPECT_EQ(contains(e, {"sweep.json", "seeds"}), "");
+  // Another part of the same sweep.
+  e = refused(plan_of("seeds: 2\nvariants:\n  - {name: fast, set: {gain: 2}}\n  - {name: slow, set: {gain: 0.5}}\n"), dir_, {1, 2});
+  EXPECT_EQ(contains(e, {"sweep.json", "1/1", "1/2"}), "");
+  EXPECT_EQ(slurp(dir_ / "sweep.json"), before);
+  EXPECT_EQ(json_files(dir_), 8U);
+}
+
+TEST_F(SweepFiles, AnEpisodeFileRecordingOtherSettingsIsAnError) {
+  const auto all = plan();
+  run_sweep(all, synthetic, dir_.string(), {1, false, {}});
+  // The file of episode 4 now says it was made with another gain.
+  const fs::path file = dir_ / "episodes" / (all[4].id() + ".json");
+  std::string text = slurp(file);
+  const auto at = text.find("\"gain\",");
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(text.find('"', at + 7), text.find('"', text.find('"', at + 7) + 1) - text.find('"', at + 7) + 1, "\"9\"");
+  std::ofstream(file) << text;
+  const std::string e = refused(all, dir_);
+  EXPECT_EQ(contains(e, {file.string(), "gain"}), "");
+}
+
+TEST_F(SweepFiles, EpisodesWithoutASweepRecordAreNotReused) {
+  const auto all = plan();
+  run_sweep(all, synthetic, dir_.string(), {1, false, {}});
+  fs::remove(dir_ / "sweep.json");  // e.g. a folder of an older ofv
+  EXPECT_EQ(contains(refused(all, dir_), {"episodes", ".json", "sweep.json"}), "");
+  EXPECT_THROW((void)load_episodes({dir_.string()}), std::invalid_argument);
+}
+
+TEST_F(SweepFiles, APlanWithTheSameEpisodeTwiceIsAnError) {
+  auto all = plan();
+  all[3].variant = all[0].variant;
+  all[3].seed = all[0].seed;
+  all[3].scenario = all[0].scenario;
+  EXPECT_EQ(contains(refused(all, dir_), {"same episode"}), "");
+}
+
+TEST_F(SweepFiles, MergeRefusesPartsOfDifferentSweeps) {
+  run_sweep(plan(), synthetic, (dir_ / "p1").string(), {1, false, {1, 2}});
+  run_sweep(plan_of("seeds: 3\naxes:\n  gain: [0.5, 1, 3]\n"), synthetic, (dir_ / "p2").string(), {1, false, {2, 2}});
+  try {
+    (void)read_sweep({(dir_ / "p1").string(), (dir_ / "p2").string()});
+    ADD_FAILURE() << "merged";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(contains(e.what(), {(dir_ / "p1" / "sweep.json").string(), (dir_ / "p2" / "sweep.json").string(),
+                                  "different sweeps", "gain=3"}),
+              "");
+  }
+}
+
+TEST_F(SweepFiles, MergeRefusesTheSameEpisodeWithDifferentResults) {
+  // Shards 1/2 and 1/3 overlap (episodes 0, 6, 12, ...); run apart, their
+  // results differ (here: another runner; in practice another machine).
+  run_sweep(plan(), synthetic, (dir_ / "p1").string(), {1, false, {1, 2}});
+  const EpisodeRunner other = [](const EpisodeSpec& s) {
+    EpisodeOutcome o = synthetic(s);
+    o.metrics.mean_visible_fraction += 0.01;
+    return o;
+  };
+  run_sweep(plan(), other, (dir_ / "p2").string(), {1, false, {1, 3}});
+  try {
+    (void)read_sweep({(dir_ / "p1").string(), (dir_ / "p2").string()});
+    ADD_FAILURE() << "merged";
+  } catch (const std::invalid_argument& e) {
+    const std::string id = plan()[0].id();
+    EXPECT_EQ(contains(e.what(), {(dir_ / "p1" / "episodes" / (id + ".json")).string(),
+                                  (dir_ / "p2" / "episodes" / (id + ".json")).string(), "different results"}),
+              "");
+  }
+  // A copy of a part is no conflict: its episodes count once.
+  fs::copy(dir_ / "p1", dir_ / "copy", fs::copy_options::recursive);
+  EXPECT_EQ(read_sweep({(dir_ / "p1").string(), (dir_ / "copy").string()}).rows.size(), plan().size() / 2);
+}
+
+TEST_F(SweepFiles, MergeNamesTheMissingEpisodes) {
+  const auto all = plan();
+  // Part 1 of 3 stops after 2 episodes, part 2 finishes, part 3 is not given.
+  int calls = 0;
+  const EpisodeRunner dies = [&](const EpisodeSpec& s) {
+    if (++calls > 2) throw std::runtime_error("killed");
+    return synthetic(s);
+  };
+  EXPECT_THROW(run_sweep(all, dies, (dir_ / "p1").string(), {1, false, {1, 3}}), std::runtime_error);
+  run_sweep(all, synthetic, (dir_ / "p2").string(), {1, false, {2, 3}});
+  const SweepEpisodes merged = read_sweep({(dir_ / "p1").string(), (dir_ / "p2").string()});
+  EXPECT_EQ(merged.planned, all.size());
+  EXPECT_EQ(merged.rows.size(), 2 + all.size() / 3);
+  ASSERT_EQ(merged.missing.size(), all.size() - merged.rows.size());
+  std::set<int> missing;
+  for (const auto& m : merged.missing) missing.insert(m.index);
+  for (const auto& r : merged.rows) EXPECT_EQ(missing.count(r.spec.index), 0U);
+  for (const auto& s : all) {
+    if (s.index % 3 == 2) {
+      EXPECT_EQ(missing.count(s.index), 1U) << "episode of the absent part " << s.index;
+    }
+  }
+}
+
+
+TEST_F(SweepFiles, PlotsRunNoShellAndQuoteEveryName) {
+  // An output folder, a scenario and a variant whose names would run
+  // commands if pasted into a shell or into the gnuplot script unquoted.
+  const fs::path marker = dir_ / "marker";
+  const std::string touch = "touch " + marker.string();
+  const fs::path out = dir_ / ("o'$(" + touch + ")'\";" + touch + ";\"`" + touch + "`");
+  Grid grid = grid_from_yaml("seeds: 1\naxes: {gain: [1, 2]}\n", "g.yaml");
+  grid.variants[1].name = "v'\nsystem '" + touch + "'\n'";
+  const auto all = plan_episodes({{"s' . system('" + touch + "') . '", "s.yaml"}}, grid);
+  run_sweep(all, synthetic, out.string(), {1, false, {}});
+  const auto pngs = write_reports(load_episodes({out.string()}), out.string());
+  EXPECT_FALSE(fs::exists(marker)) << "a name ran a command";
+  ASSERT_EQ(pngs.size(), 5U) << "gnuplot failed: " << slurp(out / "plots" / "gnuplot.log");
+  for (const auto& p : pngs) EXPECT_GT(fs::file_size(p), 1000U) << p;
+  // The script names only files of the plots folder.
+  EXPECT_EQ(slurp(out / "plots" / "plots.gp").find((dir_ / "o").string()), std::string::npos);
 }
 
 }  // namespace

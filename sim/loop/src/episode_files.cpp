@@ -1,5 +1,7 @@
 // The files of a simulated episode: trajectory, metrics, pictures, video, recording.
 #include "ofv/loop/episode_files.h"
+
+#include "gnuplot.h"
 #include "ofv/constants.h"
 
 #include "ofv/loop/metrics_json.h"
@@ -120,17 +122,19 @@ cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d,
   return img;
 }
 
-// Visibility and distance error over time, drawn by gnuplot.
+// Visibility and distance error over time, drawn by gnuplot, run in `dir`
+// without a shell: the script names its files relative to `dir`, so the
+// folder's name (the user's --out) appears nowhere.
 bool plot_visibility(const fs::path& dir) {
-  const fs::path script = dir / "visibility.gp";
-  std::ofstream gp(script);
-  gp << "set terminal pngcairo size 900,420 font 'Sans,10'\nset output '" << (dir / "visibility.png").string()
-     << "'\nset datafile separator ','\nset grid\nset xlabel 'time [s]'\nset ylabel 'visible fraction'\n"
+  std::ofstream gp(dir / "visibility.gp");
+  gp << "set terminal pngcairo size 900,420 font 'Sans,10'\nset output 'visibility.png'\n"
+        "set datafile separator ','\nset grid\nset xlabel 'time [s]'\nset ylabel 'visible fraction'\n"
         "set y2label 'distance to the sphere [cm]'\nset ytics nomirror\nset y2tics\nset yrange [0:1.05]\n"
-        "set key bottom right\nplot '" << (dir / "trajectory.csv").string()
-     << "' using \"time\":\"visible_fraction\" with lines lw 2 title 'true visible fraction', '' using \"time\":(100*column(\"sphere_distance_error\")) axes x1y2 with lines title 'distance error [cm]'\n";
+        "set key bottom right\nplot 'trajectory.csv' using \"time\":\"visible_fraction\" with lines lw 2 "
+        "title 'true visible fraction', '' using \"time\":(100*column(\"sphere_distance_error\")) axes x1y2 "
+        "with lines title 'distance error [cm]'\n";
   gp.close();
-  return std::system(("gnuplot '" + script.string() + "' 2>/dev/null").c_str()) == 0;
+  return gp && detail::run_gnuplot(dir, "visibility.gp", {});
 }
 
 }  // namespace

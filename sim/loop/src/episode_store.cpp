@@ -8,7 +8,11 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
+#include <map>
+#include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace ofv {
@@ -18,12 +22,24 @@ using nlohmann::json;
 
 namespace {
 
+constexpr const char* kSweepFormat = "ofv compare sweep 1";
+
+json settings_to_json(const std::vector<std::pair<std::string, std::string>>& settings) {
+  json out = json::array();
+  for (const auto& [k, v] : settings) out.push_back({k, v});
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> settings_from_json(const json& j) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& kv : j) out.emplace_back(kv.at(0).get<std::string>(), kv.at(1).get<std::string>());
+  return out;
+}
+
 json spec_to_json(const EpisodeSpec& s) {
-  json settings = json::array();
-  for (const auto& [k, v] : s.variant.settings) settings.push_back({k, v});
   return {{"index", s.index},     {"id", s.id()},           {"scenario", s.scenario},
           {"scenario_path", s.scenario_path}, {"variant", s.variant.name},
-          {"settings", settings}, {"seed", s.seed}};
+          {"settings", settings_to_json(s.variant.settings)}, {"seed", s.seed}};
 }
 
 EpisodeSpec spec_from_json(const json& j) {
@@ -32,11 +48,152 @@ EpisodeSpec spec_from_json(const json& j) {
   s.scenario = j.at("scenario").get<std::string>();
   s.scenario_path = j.at("scenario_path").get<std::string>();
   s.variant.name = j.at("variant").get<std::string>();
-  for (const auto& kv : j.at("settings")) {
-    s.variant.settings.emplace_back(kv.at(0).get<std::string>(), kv.at(1).get<std::string>());
-  }
+  s.variant.settings = settings_from_json(j.at("settings"));
   s.seed = j.at("seed").get<int>();
   return s;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// `a=1 b=2`, or `none`.
+std::string settings_text(const std::vector<std::pair<std::string, std::string>>& settings) {
+  std::string out;
+  for (const auto& [k, v] : settings) out += (out.empty() ? "" : " ") + k + "=" + v;
+  return out.empty() ? "none" : out;
+}
+
+// What differs between the episode a file records (there) and the one
+// expected (here); empty when they are the same episode.
+std::string episode_difference(const EpisodeSpec& there, const EpisodeSpec& here) {
+  if (there.scenario != here.scenario) return "scenario '" + there.scenario + "' there, '" + here.scenario + "' here";
+  if (there.variant.name != here.variant.name) {
+    return "variant '" + there.variant.name + "' there, '" + here.variant.name + "' here";
+  }
+  if (there.variant.settings != here.variant.settings) {
+    return "variant '" + here.variant.name + "' with settings " + settings_text(there.variant.settings) +
+           " there, " + settings_text(here.variant.settings) + " here";
+  }
+  if (there.seed != here.seed) return "seed " + std::to_string(there.seed) + " there, " + std::to_string(here.seed) + " here";
+  return {};
+}
+
+// The names in first-seen order, for messages: `a, b, c` (and how many more).
+template <class Get>
+std::vector<std::string> distinct(const std::vector<EpisodeSpec>& plan, Get get) {
+  std::vector<std::string> out;
+  std::set<std::string> seen;
+  for (const auto& s : plan) {
+    if (seen.insert(get(s)).second) out.push_back(get(s));
+  }
+  return out;
+}
+
+std::string list_text(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size() && i < 4; ++i) out += (i ? ", " : "") + names[i];
+  if (names.size() > 4) out += ", ... (" + std::to_string(names.size()) + ")";
+  return out.empty() ? "none" : out;
+}
+
+// What differs between two plans, first difference first; empty when equal.
+std::string plan_difference(const std::vector<EpisodeSpec>& there, const std::vector<EpisodeSpec>& here) {
+  if (plan_fingerprint(there) == plan_fingerprint(here) && there.size() == here.size()) {
+    bool same = true;
+    for (std::size_t i = 0; i < there.size() && same; ++i) {
+      same = there[i].index == here[i].index && there[i].identity() == here[i].identity();
+    }
+    if (same) return {};
+  }
+  const auto scenario = [](const EpisodeSpec& s) { return s.scenario; };
+  const auto variant = [](const EpisodeSpec& s) { return s.variant.name; };
+  const auto seed = [](const EpisodeSpec& s) { return std::to_string(s.seed); };
+  for (const auto& [what, get] : {std::pair<const char*, std::function<std::string(const EpisodeSpec&)>>{"scenarios", scenario},
+                                  {"variants", variant}, {"seeds", seed}}) {
+    const auto a = distinct(there, get), b = distinct(here, get);
+    if (a != b) return std::string(what) + " " + list_text(a) + " there, " + list_text(b) + " here";
+  }
+  std::map<std::string, const EpisodeSpec*> by_name;
+  for (const auto& s : there) by_name.emplace(s.variant.name, &s);
+  for (const auto& s : here) {
+    const auto it = by_name.find(s.variant.name);
+    if (it != by_name.end() && it->second->variant.settings != s.variant.settings) {
+      return episode_difference(*it->second, s);
+    }
+  }
+  return std::to_string(there.size()) + " episodes there, " + std::to_string(here.size()) +
+         " here, in another order";
+}
+
+std::string part_text(const Shard& p) { return std::to_string(p.k) + "/" + std::to_string(p.n); }
+
+// sweep.json: the whole plan (scenario and variant tables, then one
+// [scenario, variant, seed, index] per episode) and the part of this folder.
+json plan_to_json(const std::vector<EpisodeSpec>& plan, const Shard& part) {
+  json scenarios = json::array(), variants = json::array(), episodes = json::array();
+  std::map<std::string, std::size_t> scenario_at, variant_at;
+  for (const auto& s : plan) {
+    const auto [si, new_scenario] = scenario_at.emplace(s.scenario, scenario_at.size());
+    if (new_scenario) scenarios.push_back(s.scenario);
+    const std::string vkey = json{s.variant.name, settings_to_json(s.variant.settings)}.dump();
+    const auto [vi, new_variant] = variant_at.emplace(vkey, variant_at.size());
+    if (new_variant) variants.push_back({{"name", s.variant.name}, {"settings", settings_to_json(s.variant.settings)}});
+    episodes.push_back({si->second, vi->second, s.seed, s.index});
+  }
+  return {{"format", kSweepFormat}, {"fingerprint", plan_fingerprint(plan)}, {"part", part_text(part)},
+          {"scenarios", scenarios}, {"variants", variants}, {"episodes", episodes}};
+}
+
+struct SweepRecord {
+  std::vector<EpisodeSpec> plan;
+  Shard part;
+};
+
+SweepRecord read_record(const fs::path& file) {
+  SweepRecord r;
+  try {
+    const json j = json::parse(slurp(file));
+    if (j.at("format") != kSweepFormat) throw std::runtime_error("format is not '" + std::string(kSweepFormat) + "'");
+    r.part = parse_shard(j.at("part").get<std::string>());
+    const json& scenarios = j.at("scenarios");
+    const json& variants = j.at("variants");
+    for (const auto& e : j.at("episodes")) {
+      EpisodeSpec s;
+      s.scenario = scenarios.at(e.at(0).get<std::size_t>()).get<std::string>();
+      const json& v = variants.at(e.at(1).get<std::size_t>());
+      s.variant.name = v.at("name").get<std::string>();
+      s.variant.settings = settings_from_json(v.at("settings"));
+      s.seed = e.at(2).get<int>();
+      s.index = e.at(3).get<int>();
+      r.plan.push_back(std::move(s));
+    }
+    if (plan_fingerprint(r.plan) != j.at("fingerprint").get<std::string>()) {
+      throw std::runtime_error("its fingerprint does not match its episodes");
+    }
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(file.string() + ": not a sweep record of ofv compare: " + e.what());
+  }
+  return r;
+}
+
+// An episode's .json: the spec it records (checked against its file name)
+// and the whole object.
+std::pair<EpisodeSpec, json> read_episode(const fs::path& file) {
+  try {
+    json j = json::parse(slurp(file));
+    EpisodeSpec spec = spec_from_json(j);
+    if (spec.id() != file.stem().string()) {
+      throw std::runtime_error("it records " + spec.id() + " (scenario '" + spec.scenario + "', variant '" +
+                               spec.variant.name + "', seed " + std::to_string(spec.seed) + ")");
+    }
+    return {spec, j};
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(file.string() + ": not a finished episode of this name: " + e.what());
+  }
 }
 
 }  // namespace
@@ -51,12 +208,48 @@ void write_file_atomically(const fs::path& path, const std::string& text) {
   fs::rename(tmp, path);
 }
 
-EpisodeStore::EpisodeStore(const std::string& out_dir) : dir_(fs::path(out_dir) / "episodes") {
+EpisodeStore::EpisodeStore(const std::string& out_dir, const std::vector<EpisodeSpec>& plan, Shard part)
+    : dir_(fs::path(out_dir) / "episodes") {
+  std::map<std::string, const EpisodeSpec*> ids;
+  for (const auto& s : plan) {
+    const auto [it, inserted] = ids.emplace(s.id(), &s);
+    if (!inserted) {
+      throw std::invalid_argument("episodes " + std::to_string(it->second->index) + " and " +
+                                  std::to_string(s.index) + " of the sweep are the same episode " + s.identity());
+    }
+  }
+  (void)shard(plan, part.k, part.n);  // checks the part
+  const fs::path record = fs::path(out_dir) / "sweep.json";
+  const bool recorded = fs::exists(record);
+  if (recorded) {
+    const SweepRecord there = read_record(record);
+    const std::string diff = plan_difference(there.plan, plan);
+    if (!diff.empty()) {
+      throw std::invalid_argument(record.string() + ": the folder holds another sweep (" + diff +
+                                  "): give another --out");
+    }
+    if (there.part.k != part.k || there.part.n != part.n) {
+      throw std::invalid_argument(record.string() + ": the folder holds part " + part_text(there.part) +
+                                  " of this sweep, not " + part_text(part) + ": give another --out");
+    }
+  } else if (fs::is_directory(dir_)) {
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      if (e.path().extension() == ".json") {
+        throw std::invalid_argument(e.path().string() + ": an episode without " + record.string() +
+                                    " (another sweep, or an older ofv): give another --out");
+      }
+    }
+  }
   fs::create_directories(dir_);
+  if (!recorded) write_file_atomically(record, plan_to_json(plan, part).dump() + "\n");
 }
 
 bool EpisodeStore::finished(const EpisodeSpec& spec) const {
-  return fs::exists(dir_ / (spec.id() + ".json"));
+  const fs::path file = dir_ / (spec.id() + ".json");
+  if (!fs::exists(file)) return false;
+  const std::string diff = episode_difference(read_episode(file).first, spec);
+  if (!diff.empty()) throw std::invalid_argument(file.string() + ": another episode (" + diff + ")");
+  return true;
 }
 
 void EpisodeStore::write(const EpisodeSpec& spec, const EpisodeOutcome& outcome) const {
@@ -69,35 +262,79 @@ void EpisodeStore::write(const EpisodeSpec& spec, const EpisodeOutcome& outcome)
   write_file_atomically(dir_ / (spec.id() + ".json"), j.dump(1) + "\n");
 }
 
-std::vector<EpisodeRow> load_episodes(const std::vector<std::string>& dirs) {
-  std::vector<EpisodeRow> rows;
-  std::set<std::string> seen;
+SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
+  SweepEpisodes out;
+  std::optional<SweepRecord> sweep;
+  fs::path sweep_file;
+  std::map<std::string, const EpisodeSpec*> planned;  // id -> the plan's episode
+  struct Found {
+    fs::path file;
+    json content;  // without the machine-dependent scenario path
+  };
+  std::map<std::string, Found> found;
   for (const auto& d : dirs) {
     const fs::path dir = fs::path(d) / "episodes";
     if (!fs::is_directory(dir)) throw std::invalid_argument(d + ": no episodes/ folder (not an ofv compare output)");
+    const fs::path record = fs::path(d) / "sweep.json";
+    if (!fs::exists(record)) {
+      throw std::invalid_argument(record.string() + ": missing (not an ofv compare output, or one of an older ofv)");
+    }
+    SweepRecord r = read_record(record);
+    if (!sweep) {
+      sweep = std::move(r);
+      sweep_file = record;
+      for (const auto& s : sweep->plan) planned.emplace(s.id(), &s);
+    } else {
+      const std::string diff = plan_difference(sweep->plan, r.plan);
+      if (!diff.empty()) {
+        throw std::invalid_argument(sweep_file.string() + " and " + record.string() +
+                                    ": parts of different sweeps (" + diff + ")");
+      }
+    }
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(dir)) {
       if (e.path().extension() == ".json") files.push_back(e.path());
     }
     std::sort(files.begin(), files.end());
     for (const auto& f : files) {
-      std::ifstream in(f);
+      auto [spec, j] = read_episode(f);
+      const auto plan = planned.find(spec.id());
+      if (plan == planned.end() || !episode_difference(*plan->second, spec).empty()) {
+        throw std::invalid_argument(f.string() + ": not an episode of the sweep of " + record.string());
+      }
+      j.erase("scenario_path");
+      const auto [it, inserted] = found.emplace(spec.id(), Found{f, j});
+      if (!inserted) {
+        if (it->second.content != j) {
+          throw std::invalid_argument(it->second.file.string() + " and " + f.string() +
+                                      ": the same episode with different results (keep one of them)");
+        }
+        continue;  // the same file twice (e.g. a copied part)
+      }
+      EpisodeRow row;
+      row.spec = spec;
+      row.spec.index = plan->second->index;
       try {
-        const json j = json::parse(in);
-        EpisodeRow row;
-        row.spec = spec_from_json(j);
         row.metrics = metrics_from_json(j.at("metrics"));
-        row.trajectory_csv = (dir / (row.spec.id() + ".csv")).string();
-        if (seen.insert(row.spec.id()).second) rows.push_back(row);
       } catch (const std::exception& e) {
         throw std::invalid_argument(f.string() + ": not a finished episode: " + e.what());
       }
+      row.trajectory_csv = (dir / (spec.id() + ".csv")).string();
+      out.rows.push_back(row);
     }
   }
-  std::stable_sort(rows.begin(), rows.end(), [](const EpisodeRow& a, const EpisodeRow& b) {
+  if (sweep) {
+    out.planned = sweep->plan.size();
+    for (const auto& s : sweep->plan) {
+      if (found.count(s.id()) == 0) out.missing.push_back(s);
+    }
+  }
+  std::stable_sort(out.rows.begin(), out.rows.end(), [](const EpisodeRow& a, const EpisodeRow& b) {
     return a.spec.index < b.spec.index;
   });
-  return rows;
+  return out;
 }
+
+std::vector<EpisodeRow> load_episodes(const std::vector<std::string>& dirs) { return read_sweep(dirs).rows; }
 
 }  // namespace ofv

@@ -3,7 +3,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -15,6 +17,36 @@ namespace {
 [[noreturn]] void grid_error(const std::string& source, const std::string& key,
                              const std::string& what) {
   throw std::invalid_argument(source + ": " + key + ": " + what);
+}
+
+// The text of a mapping's key; keys are plain words, never lists or maps.
+std::string key_text(const YAML::Node& key, const std::string& source, const std::string& at) {
+  if (!key.IsScalar()) {
+    grid_error(source + ":" + std::to_string(key.Mark().line + 1), at.empty() ? "(top level)" : at,
+               "expected a word as key");
+  }
+  return key.Scalar();
+}
+
+// yaml-cpp keeps every pair of a mapping but answers lookups with the first
+// of repeated keys, so a repeated key would be silently ignored: refuse it,
+// in every mapping of the file, naming the key and both lines.
+void check_unique_keys(const YAML::Node& n, const std::string& source, const std::string& at) {
+  if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) check_unique_keys(n[i], source, at + "[" + std::to_string(i) + "]");
+  } else if (n.IsMap()) {
+    std::map<std::string, int> lines;  // key -> first line (1-based)
+    for (const auto& item : n) {
+      const std::string key = key_text(item.first, source, at);
+      const int line = item.first.Mark().line + 1;
+      const auto [first, inserted] = lines.emplace(key, line);
+      if (!inserted) {
+        grid_error(source + ":" + std::to_string(line), at.empty() ? key : at + "." + key,
+                   "duplicate key '" + key + "' (first on line " + std::to_string(first->second) + ")");
+      }
+      check_unique_keys(item.second, source, at.empty() ? key : at + "." + key);
+    }
+  }
 }
 
 std::string scalar_text(const YAML::Node& n, const std::string& source, const std::string& key) {
@@ -45,6 +77,7 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
     throw std::invalid_argument(source + ": invalid YAML: " + e.what());
   }
   if (!root.IsMap()) throw std::invalid_argument(source + ": expected a map with 'variants' and/or 'axes'");
+  check_unique_keys(root, source, "");
   Grid grid;
   std::vector<Variant> base;
   std::vector<std::pair<std::string, std::string>> common;
@@ -55,16 +88,20 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
     if (key == "name") {
       grid.name = scalar_text(n, source, key);
     } else if (key == "seeds") {
+      const std::string range = "expected an integer in 1.." + std::to_string(kMaxSeeds) + ", got ";
       try {
         grid.seeds = n.as<int>();
       } catch (const YAML::Exception&) {
-        grid_error(source, key, "expected a positive integer, got '" + scalar_text(n, source, key) + "'");
+        grid_error(source, key, range + "'" + scalar_text(n, source, key) + "'");
       }
-      if (grid.seeds < 1) grid_error(source, key, "expected a positive integer, got " + std::to_string(grid.seeds));
+      if (grid.seeds < 1 || grid.seeds > kMaxSeeds) grid_error(source, key, range + std::to_string(grid.seeds));
     } else if (key == "set") {
       common = settings_map(n, source, key);
     } else if (key == "variants") {
-      if (!n.IsSequence()) grid_error(source, key, "expected a list of {name, set}");
+      if (!n.IsSequence() || n.size() == 0) grid_error(source, key, "expected a non-empty list of {name, set}");
+      if (n.size() > kMaxVariants) {
+        grid_error(source, key, std::to_string(n.size()) + " variants, more than " + std::to_string(kMaxVariants));
+      }
       for (std::size_t i = 0; i < n.size(); ++i) {
         const std::string at = key + "[" + std::to_string(i) + "]";
         if (!n[i].IsMap()) grid_error(source, at, "expected {name: ..., set: {...}}");
@@ -83,7 +120,7 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
         base.push_back(v);
       }
     } else if (key == "axes") {
-      if (!n.IsMap()) grid_error(source, key, "expected a map of setting: [values]");
+      if (!n.IsMap() || n.size() == 0) grid_error(source, key, "expected a non-empty map of setting: [values]");
       for (const auto& a : n) {
         const std::string name = a.first.as<std::string>();
         if (!a.second.IsSequence() || a.second.size() == 0) {
@@ -98,6 +135,22 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
     } else {
       grid_error(source, key, "unknown key (expected name, seeds, set, variants, axes)");
     }
+  }
+  if (base.empty() && axes.empty()) {
+    throw std::invalid_argument(source + ": variants: missing (a grid needs 'variants' and/or 'axes')");
+  }
+  // Counted before anything is expanded: a few lines of axes can multiply
+  // to more variants than memory holds. Overflow-safe: n * size > max
+  // exactly when size > max / n.
+  std::size_t count = std::max<std::size_t>(base.size(), 1);
+  std::string product = std::to_string(count);
+  for (const auto& [name, values] : axes) {
+    product += " x " + std::to_string(values.size());
+    if (values.size() > kMaxVariants / count) {
+      grid_error(source, "axes." + name, "the grid would have more than " + std::to_string(kMaxVariants) +
+                                             " variants (" + product + (axes.back().first == name ? "" : " x ...") + ")");
+    }
+    count *= values.size();
   }
   if (base.empty()) base.push_back(Variant{"", {}});
   // The grid's own settings come first: a variant's may override them.

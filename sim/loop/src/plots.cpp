@@ -1,12 +1,14 @@
 // The plots of `ofv compare`: data files and one gnuplot script, run once.
 #include "ofv/loop/plots.h"
 
+#include "gnuplot.h"
+
 #include "ofv/loop/reports.h"
 #include "ofv/loop/statistics.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 namespace ofv {
@@ -15,24 +17,27 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Quotes a path or title for a gnuplot string.
-std::string gp(const fs::path& p) {
-  std::string out = "'";
-  for (char ch : p.string()) out += ch == '\'' ? std::string("''") : std::string(1, ch);
-  return out + "'";
-}
+using detail::gnuplot_string;
 
-// Visible fraction over time: the first seed of each variant.
-void visibility_plot(const EpisodeGroups& grouped, const std::string& scenario,
-                     const fs::path& png, std::ostream& script) {
-  script << "set output " << gp(png) << "\nset title 'True visible fraction over time: "
-         << scenario << " (seed 0)' noenhanced\nset xlabel 'time [s]'\nset ylabel 'visible fraction'\n"
+// Visible fraction over time: the first seed of each variant. gnuplot runs
+// in the plots folder and the script names only files there, so that no
+// path (the user's --out, the folders of merged parts) enters the script:
+// the trajectories are copied beside it as `<stem>_<k>.csv`.
+void visibility_plot(const EpisodeGroups& grouped, const std::string& scenario, const fs::path& plot_dir,
+                     const std::string& stem, std::ostream& script) {
+  script << "set output " << gnuplot_string(stem + ".png") << "\nset title "
+         << gnuplot_string("True visible fraction over time: " + scenario + " (seed 0)")
+         << " noenhanced\nset xlabel 'time [s]'\nset ylabel 'visible fraction'\n"
          << "set yrange [0:1.05]\nplot ";
   bool first = true;
+  int k = 0;
   for (const auto& g : grouped.groups) {
     if (g.scenario != scenario) continue;
-    script << (first ? "" : ", ") << gp(g.rows.front().trajectory_csv)
-           << " using \"time\":\"visible_fraction\" with lines lw 2 title " << gp(g.variant.name) << " noenhanced";
+    const std::string data = stem + "_" + std::to_string(k++) + ".csv";
+    fs::copy_file(g.rows.front().trajectory_csv, plot_dir / data, fs::copy_options::overwrite_existing);
+    script << (first ? "" : ", ") << gnuplot_string(data)
+           << " using \"time\":\"visible_fraction\" with lines lw 2 title " << gnuplot_string(g.variant.name)
+           << " noenhanced";
     first = false;
   }
   script << "\nset yrange [*:*]\n";
@@ -41,7 +46,8 @@ void visibility_plot(const EpisodeGroups& grouped, const std::string& scenario,
 // A metric's bar chart: variants side by side, one cluster per scenario,
 // from a data file with a mean and a half-width column per variant.
 void bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const std::string& label,
-               const fs::path& data, const fs::path& png, std::ostream& script) {
+               const fs::path& plot_dir, const std::string& stem, std::ostream& script) {
+  const std::string data = stem + ".csv";
   std::ostringstream dat;
   dat << "# scenario";  // a comment, so that gnuplot does not plot it
   for (const auto& v : grouped.variants) dat << ',' << csv_field(v) << ',' << csv_field(v + " ci");
@@ -59,15 +65,15 @@ void bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const s
     }
     dat << '\n';
   }
-  write_file_atomically(data, dat.str());
-  script << "set output " << gp(png) << "\nset title '" << label
+  write_file_atomically(plot_dir / data, dat.str());
+  script << "set output " << gnuplot_string(stem + ".png") << "\nset title '" << label
          << " per setting (mean, 95 % CI)'\nset style data histogram\n"
             "set style histogram errorbars gap 1 lw 1\nset style fill solid 0.6 border -1\n"
             "set xtics rotate by -20 noenhanced\nset xlabel ''\nset ylabel '"
          << label << "'\nset yrange [0:*]\nplot ";
   for (std::size_t k = 0; k < grouped.variants.size(); ++k) {
-    script << (k ? ", " : "") << gp(data) << " using " << 2 + 2 * k << ':' << 3 + 2 * k
-           << ":xtic(1) title " << gp(grouped.variants[k]) << " noenhanced";
+    script << (k ? ", " : "") << gnuplot_string(data) << " using " << 2 + 2 * k << ':' << 3 + 2 * k
+           << ":xtic(1) title " << gnuplot_string(grouped.variants[k]) << " noenhanced";
   }
   script << "\nunset style\nset style data lines\nset xtics norotate\nset yrange [*:*]\n";
 }
@@ -87,10 +93,13 @@ std::vector<std::string> write_plots(const std::vector<EpisodeRow>& rows,
             "set linetype 15 lc rgb '#d62728'\nset linetype 16 lc rgb '#9467bd'\nset linetype cycle 16\n"
             "set key outside right\nset grid\n";
   std::vector<std::string> pngs;
+  std::set<std::string> stems;
   for (const auto& scenario : grouped.scenarios) {
-    const fs::path png = plot_dir / ("visibility_" + safe_name(scenario) + ".png");
-    visibility_plot(grouped, scenario, png, script);
-    pngs.push_back(png.string());
+    // Scenario names that differ only in characters a file name drops get their own file.
+    std::string stem = "visibility_" + safe_name(scenario);
+    for (int n = 2; !stems.insert(stem).second; ++n) stem = "visibility_" + safe_name(scenario) + "-" + std::to_string(n);
+    visibility_plot(grouped, scenario, plot_dir, stem, script);
+    pngs.push_back((plot_dir / (stem + ".png")).string());
   }
   const std::vector<std::pair<std::string, std::string>> bars{
       {"mean_visible_fraction", "mean visible fraction"},
@@ -100,15 +109,11 @@ std::vector<std::string> write_plots(const std::vector<EpisodeRow>& rows,
   for (const auto& [metric, label] : bars) {
     const auto column = std::find_if(metric_columns().begin(), metric_columns().end(),
                                      [&](const MetricColumn& c) { return metric == c.name; });
-    const fs::path png = plot_dir / (metric + ".png");
-    bar_chart(grouped, *column, label, plot_dir / (metric + ".csv"), png, script);
-    pngs.push_back(png.string());
+    bar_chart(grouped, *column, label, plot_dir, metric, script);
+    pngs.push_back((plot_dir / (metric + ".png")).string());
   }
-  const fs::path script_path = plot_dir / "plots.gp";
-  write_file_atomically(script_path, script.str());
-  const std::string command = "gnuplot \"" + script_path.string() + "\" 2>\"" +
-                              (plot_dir / "gnuplot.log").string() + "\"";
-  if (std::system(command.c_str()) != 0) {
+  write_file_atomically(plot_dir / "plots.gp", script.str());
+  if (!detail::run_gnuplot(plot_dir, "plots.gp", plot_dir / "gnuplot.log")) {
     std::cerr << "ofv compare: warning: gnuplot failed or is missing (see "
               << (plot_dir / "gnuplot.log").string() << "); tables were written\n";
     return {};

@@ -27,6 +27,16 @@ std::vector<std::pair<std::string, std::string>> scenario_set(const std::vector<
       out.emplace_back(s.name, s.path);
     }
   }
+  // Scenario names key the episodes and the tables: two files of the same
+  // name (a/x.yaml, b/x.yaml) would be one row.
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (out[i].first == out[j].first) {
+        throw std::invalid_argument("--scenarios " + out[i].second + ": the scenario name '" + out[i].first +
+                                    "' is used twice (also " + out[j].second + ")");
+      }
+    }
+  }
   return out;
 }
 

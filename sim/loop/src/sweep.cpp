@@ -8,7 +8,11 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cctype>
+#include <cstdint>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,13 +26,56 @@ std::string safe_name(const std::string& text) {
   return out;
 }
 
+std::string fingerprint(const std::string& text) {
+  std::uint64_t h = 14695981039346656037ULL;  // FNV-1a, 64 bits
+  for (const char ch : text) {
+    h ^= static_cast<unsigned char>(ch);
+    h *= 1099511628211ULL;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+std::string EpisodeSpec::identity() const {
+  nlohmann::json settings = nlohmann::json::array();
+  for (const auto& [k, v] : variant.settings) settings.push_back({k, v});
+  return nlohmann::json{{"scenario", scenario}, {"variant", variant.name}, {"settings", settings}, {"seed", seed}}
+      .dump();
+}
+
 std::string EpisodeSpec::id() const {
-  return safe_name(scenario) + "__" + safe_name(variant.name) + "__seed" + std::to_string(seed);
+  // Shortened so that the name stays far below the 255 bytes of a file name.
+  return safe_name(scenario).substr(0, 48) + "__" + safe_name(variant.name).substr(0, 96) + "__seed" +
+         std::to_string(seed) + "__" + fingerprint(identity());
+}
+
+std::string plan_fingerprint(const std::vector<EpisodeSpec>& plan) {
+  std::string all;
+  for (const auto& s : plan) all += std::to_string(s.index) + " " + s.identity() + "\n";
+  return fingerprint(all);
+}
+
+void check_sweep_size(std::size_t scenarios, std::size_t variants, int seeds) {
+  const std::string what = std::to_string(scenarios) + " scenarios x " + std::to_string(variants) +
+                           " variants x " + std::to_string(seeds) + " seeds";
+  if (seeds < 1 || seeds > kMaxSeeds) {
+    throw std::invalid_argument("seeds: expected an integer in 1.." + std::to_string(kMaxSeeds) + ", got " +
+                                std::to_string(seeds));
+  }
+  if (scenarios == 0 || variants == 0) throw std::invalid_argument(what + ": nothing to run");
+  // Overflow-safe: a * b > max exactly when b > max / a (integers, a > 0).
+  const auto s = static_cast<std::size_t>(seeds);
+  if (variants > kMaxEpisodes / scenarios || s > kMaxEpisodes / (scenarios * variants)) {
+    throw std::invalid_argument(what + ": more than " + std::to_string(kMaxEpisodes) + " episodes");
+  }
 }
 
 std::vector<EpisodeSpec> plan_episodes(
     const std::vector<std::pair<std::string, std::string>>& scenarios, const Grid& grid) {
+  check_sweep_size(scenarios.size(), grid.variants.size(), grid.seeds);
   std::vector<EpisodeSpec> out;
+  out.reserve(scenarios.size() * grid.variants.size() * static_cast<std::size_t>(grid.seeds));
   for (const auto& [name, path] : scenarios) {
     for (const Variant& v : grid.variants) {
       for (int seed = 0; seed < grid.seeds; ++seed) {
@@ -67,13 +114,15 @@ std::vector<EpisodeSpec> shard(const std::vector<EpisodeSpec>& all, int k, int n
   return out;
 }
 
-int run_sweep(const std::vector<EpisodeSpec>& episodes, const EpisodeRunner& runner,
+int run_sweep(const std::vector<EpisodeSpec>& plan, const EpisodeRunner& runner,
               const std::string& out_dir, const SweepOptions& options) {
-  if (options.jobs < 0) {
-    throw std::invalid_argument("jobs must be >= 0 (0: one per core), got " +
-                                std::to_string(options.jobs));
+  if (options.jobs < 0 || options.jobs > kMaxJobs) {
+    throw std::invalid_argument("jobs: expected an integer in 0.." + std::to_string(kMaxJobs) +
+                                " (0: one per core), got " + std::to_string(options.jobs));
   }
-  const EpisodeStore store(out_dir);
+  const std::vector<EpisodeSpec> episodes = shard(plan, options.part.k, options.part.n);
+  // Checks the folder (and the plan) before anything runs.
+  const EpisodeStore store(out_dir, plan, options.part);
   std::vector<const EpisodeSpec*> todo;
   for (const auto& s : episodes) {
     if (!store.finished(s)) todo.push_back(&s);

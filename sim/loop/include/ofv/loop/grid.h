@@ -5,11 +5,19 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace ofv {
+
+/// \brief The most seeds per scenario x variant (`seeds:` of a grid, `--seeds`).
+inline constexpr int kMaxSeeds = 1000;
+/// \brief The most episodes (scenarios x variants x seeds) of one sweep.
+inline constexpr std::size_t kMaxEpisodes = 100000;
+/// \brief The most variants of one grid, after expanding its axes.
+inline constexpr std::size_t kMaxVariants = kMaxEpisodes;
 
 /// \brief One column of the comparison: a named list of settings `name=value`.
 struct Variant {
@@ -20,11 +28,16 @@ struct Variant {
 /// \brief The settings grid of `ofv compare --grid GRID.yaml` (see docs/compare.md).
 struct Grid {
   std::string name = "grid";
-  int seeds = 3;                  ///< seeds per scenario x variant (`--seeds` overrides)
+  int seeds = 3;                  ///< seeds per scenario x variant, 1..kMaxSeeds (`--seeds` overrides)
   std::vector<Variant> variants;  ///< after expanding `axes` (cartesian product)
 };
 
-/// \brief Reads a grid; errors name the file, the key and the value.
+/// \brief Reads a grid; errors name the file, the key and the value (and
+///        the line, for a key that appears twice in a mapping).
+/// \throws std::invalid_argument for unknown or repeated keys, an empty list
+///         of variants or axes, seeds outside 1..kMaxSeeds, more than
+///         kMaxVariants variants (counted before expanding the axes) or a
+///         variant name used twice.
 [[nodiscard]] Grid read_grid(const std::string& path);
 /// \brief Parses a grid from YAML text; `source` names it in errors.
 [[nodiscard]] Grid grid_from_yaml(const std::string& text, const std::string& source);

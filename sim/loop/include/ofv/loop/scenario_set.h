@@ -16,8 +16,8 @@ namespace ofv {
 /**
  * \brief Scenario names and paths, as plan_episodes() takes them, from
  *        scenario files, folders (their `*.yaml`, sorted) and built-in names.
- * \throws std::invalid_argument naming the argument: an empty folder, or a
- *         scenario that does not load.
+ * \throws std::invalid_argument naming the argument: an empty folder, a
+ *         scenario that does not load, or two scenarios of the same name.
  */
 [[nodiscard]] std::vector<std::pair<std::string, std::string>> scenario_set(
     const std::vector<std::string>& args);

@@ -27,7 +27,21 @@ struct EpisodeSpec {
   std::string scenario_path;
   Variant variant;
   int seed = 0;
-  /// \brief Stable file-name-safe identifier: scenario, variant and seed.
+  /**
+   * \brief What makes two episodes the same: the scenario's name, the
+   *        variant's name, its settings in the order they apply, and the
+   *        seed — as canonical JSON text, so different episodes always have
+   *        different identities (the scenario's file path and the index are
+   *        not part of it).
+   */
+  [[nodiscard]] std::string identity() const;
+  /**
+   * \brief The episode's file name (without extension):
+   *        `<scenario>__<variant>__seed<k>__<fingerprint>`, the names
+   *        shortened and made file-name safe for reading, and the
+   *        fingerprint of identity() keeping names that differ only in
+   *        dropped characters (`a/b`, `a_b`) or contain `__` apart.
+   */
   [[nodiscard]] std::string id() const;
 };
 
@@ -35,7 +49,26 @@ struct EpisodeSpec {
 ///        `.` replaced by `_`, for use in file names.
 [[nodiscard]] std::string safe_name(const std::string& text);
 
+/// \brief 16 hexadecimal digits of a 64-bit FNV-1a hash of `text`: a stable
+///        fingerprint for file names and plan checks (not cryptographic;
+///        equal fingerprints are always confirmed by comparing the texts).
+[[nodiscard]] std::string fingerprint(const std::string& text);
+
+/// \brief The fingerprint of a whole sweep: of every episode's identity and
+///        index, in order.
+[[nodiscard]] std::string plan_fingerprint(const std::vector<EpisodeSpec>& plan);
+
+/// \brief The most episodes run in parallel (`--jobs`).
+inline constexpr int kMaxJobs = 256;
+
+/// \brief Checks the size of a sweep before it is planned: 1..kMaxSeeds
+///        seeds, at least one scenario and variant, and at most kMaxEpisodes
+///        episodes (computed without overflow).
+/// \throws std::invalid_argument giving the counts.
+void check_sweep_size(std::size_t scenarios, std::size_t variants, int seeds);
+
 /// \brief Every scenario x variant x seed, in a fixed order.
+/// \throws std::invalid_argument from check_sweep_size(), before anything is allocated.
 [[nodiscard]] std::vector<EpisodeSpec> plan_episodes(
     const std::vector<std::pair<std::string, std::string>>& scenarios,  // name, path
     const Grid& grid);
@@ -65,23 +98,34 @@ using EpisodeRunner = std::function<EpisodeOutcome(const EpisodeSpec&)>;
 
 /// \brief Options of run_sweep().
 struct SweepOptions {
-  int jobs = 1;           ///< episodes in parallel; 0: one per core
+  int jobs = 1;           ///< episodes in parallel, 0..kMaxJobs; 0: one per core
   bool progress = false;  ///< progress bar with ETA on stderr (when it is a terminal)
+  Shard part;             ///< the part of the sweep to run (`--shard`); 1/1: all of it
 };
 
 /**
- * \brief Runs the episodes not yet finished in `out_dir`/episodes and writes
- *        each as `<id>.json` (spec + metrics) and `<id>.csv` (trajectory) as
- *        soon as it ends, so an interrupted sweep resumes where it stopped.
+ * \brief Runs the episodes of part `options.part` of the sweep `plan` not yet
+ *        finished in `out_dir`/episodes and writes each as `<id>.json` (spec
+ *        + metrics) and `<id>.csv` (trajectory) as soon as it ends, so an
+ *        interrupted sweep resumes where it stopped.
  *
- * The files do not depend on `options.jobs`: episodes are independent and
- * each is written to its own files.
+ * `out_dir`/sweep.json records the whole plan and the part: a folder belongs
+ * to one sweep. Before anything runs, the folder is checked: another sweep's
+ * folder (a different plan or part), episodes without a `sweep.json`, or an
+ * episode file whose recorded scenario, variant, settings or seed differ
+ * from the plan's are errors, never reused. The files do not depend on
+ * `options.jobs`: episodes are independent and each is written to its own
+ * files.
+ * \param plan the whole sweep (every part), e.g. from plan_episodes().
  * \return the number of episodes run (not resumed).
+ * \throws std::invalid_argument, before anything runs or is written, if
+ *         `options.jobs` is outside 0..kMaxJobs, the part is not 1 <= K <= N,
+ *         two episodes of the plan share an identity, or the folder holds
+ *         something else (the message names the file and what differs).
  * \throws std::runtime_error if an episode fails (its message names the
  *         episode); episodes not yet started are then skipped.
- * \throws std::invalid_argument if `options.jobs` is negative.
  */
-int run_sweep(const std::vector<EpisodeSpec>& episodes, const EpisodeRunner& runner,
+int run_sweep(const std::vector<EpisodeSpec>& plan, const EpisodeRunner& runner,
               const std::string& out_dir, const SweepOptions& options);
 
 }  // namespace ofv
