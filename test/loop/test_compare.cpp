@@ -368,5 +368,21 @@ TEST_F(SweepFiles, PlotsRunNoShellAndQuoteEveryName) {
   EXPECT_EQ(slurp(out / "plots" / "plots.gp").find((dir_ / "o").string()), std::string::npos);
 }
 
+TEST_F(SweepFiles, AMetricWithNoValueHasNoChartAndTheOthersAreDrawn) {
+  // Nothing recovers (worst recovery is n/a everywhere): gnuplot would
+  // refuse the whole script over that one empty chart.
+  const EpisodeRunner never = [](const EpisodeSpec& s) {
+    EpisodeOutcome o = synthetic(s);
+    for (auto& step : o.steps) step.visible_fraction = step.time >= 0.3 ? 0.5 : 1.0;
+    o.metrics = summarise(o.steps);
+    return o;
+  };
+  const auto all = plan_episodes({{"hidden", "s.yaml"}}, grid_from_yaml("seeds: 1\naxes: {gain: [1, 2]}\n", "g.yaml"));
+  run_sweep(all, never, dir_.string(), {1, false, {}});
+  const auto pngs = write_reports(load_episodes({dir_.string()}), dir_.string());
+  ASSERT_EQ(pngs.size(), 4U) << "gnuplot failed: " << slurp(dir_ / "plots" / "gnuplot.log");
+  for (const auto& p : pngs) EXPECT_EQ(p.find("max_recovery_time"), std::string::npos) << p;
+}
+
 }  // namespace
 }  // namespace ofv

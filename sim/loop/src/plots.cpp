@@ -7,6 +7,7 @@
 #include "ofv/loop/statistics.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -44,11 +45,14 @@ void visibility_plot(const EpisodeGroups& grouped, const std::string& scenario, 
 }
 
 // A metric's bar chart: variants side by side, one cluster per scenario,
-// from a data file with a mean and a half-width column per variant.
-void bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const std::string& label,
+// from a data file with a mean and a half-width column per variant. None
+// when no episode has a value (worst recovery where none recovered): gnuplot
+// cannot plot an empty chart.
+bool bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const std::string& label,
                const fs::path& plot_dir, const std::string& stem, std::ostream& script) {
   const std::string data = stem + ".csv";
   std::ostringstream dat;
+  bool any = false;
   dat << "# scenario";  // a comment, so that gnuplot does not plot it
   for (const auto& v : grouped.variants) dat << ',' << csv_field(v) << ',' << csv_field(v + " ci");
   dat << '\n';
@@ -60,11 +64,13 @@ void bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const s
         dat << ",,";
       } else {
         const Interval i = g->interval(column);
+        any = any || std::isfinite(i.mean);
         dat << ',' << csv_number(i.mean) << ',' << csv_number(i.half_width);
       }
     }
     dat << '\n';
   }
+  if (!any) return false;
   write_file_atomically(plot_dir / data, dat.str());
   script << "set output " << gnuplot_string(stem + ".png") << "\nset title '" << label
          << " per setting (mean, 95 % CI)'\nset style data histogram\n"
@@ -76,6 +82,7 @@ void bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const s
            << ":xtic(1) title " << gnuplot_string(grouped.variants[k]) << " noenhanced";
   }
   script << "\nunset style\nset style data lines\nset xtics norotate\nset yrange [*:*]\n";
+  return true;
 }
 
 }  // namespace
@@ -109,8 +116,7 @@ std::vector<std::string> write_plots(const std::vector<EpisodeRow>& rows,
   for (const auto& [metric, label] : bars) {
     const auto column = std::find_if(metric_columns().begin(), metric_columns().end(),
                                      [&](const MetricColumn& c) { return metric == c.name; });
-    bar_chart(grouped, *column, label, plot_dir, metric, script);
-    pngs.push_back((plot_dir / (metric + ".png")).string());
+    if (bar_chart(grouped, *column, label, plot_dir, metric, script)) pngs.push_back((plot_dir / (metric + ".png")).string());
   }
   write_file_atomically(plot_dir / "plots.gp", script.str());
   if (!detail::run_gnuplot(plot_dir, "plots.gp", plot_dir / "gnuplot.log")) {
