@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -55,6 +56,24 @@ void check_inputs(const ViewProblem& problem, const EstimatorSettings& settings)
   require_finite("centroid", problem.centroid);
   require_finite("camera", problem.camera);
   require_finite("previous_view", problem.previous_view);
+  // Extreme but finite coordinates (non-finite ones are §7's to skip).
+  const auto require_in_range = [](const std::string& name, const Eigen::Matrix3Xd& m) {
+    for (Eigen::Index k = 0; k < m.cols(); ++k) {
+      for (int i = 0; i < 3; ++i) {
+        if (std::isfinite(m(i, k)) && std::abs(m(i, k)) > kMaxLength) {
+          usage_error(name + " " + std::to_string(k) + " has a coordinate beyond " + format_value(kMaxLength) +
+                      " m: " + format_value(Eigen::Vector3d(m.col(k))));
+        }
+      }
+    }
+  };
+  require_in_range("supervoxel position", problem.positions);
+  require_in_range("supervoxel normal", problem.normals);
+  require_in_range("occluder", problem.occluders);
+  for (const auto& [name, p] : {std::pair{"centroid", &problem.centroid}, std::pair{"camera", &problem.camera},
+                                std::pair{"previous_view", &problem.previous_view}}) {
+    if (*p) require_in_range(name, **p);
+  }
   if (problem.axes) {  // §2: a zero-length or non-finite given axis
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d e = problem.axes->col(k);
@@ -718,6 +737,8 @@ class CycleDetector {
   long period_ = 1;
 };
 
+using Clock = std::chrono::steady_clock;
+
 struct IterationResult {
   Eigen::Vector3d tf;
   ViewStatus status;
@@ -730,7 +751,8 @@ struct IterationResult {
 // to `path` when given.
 IterationResult iterate(const OcclusionRays& occ, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& t0, const ObjectFrame& object,
-                        const EstimatorSettings& settings, std::vector<Eigen::Vector3d>* path) {
+                        const EstimatorSettings& settings, Clock::time_point deadline,
+                        std::vector<Eigen::Vector3d>* path) {
   const Eigen::Vector3d& c = object.c;
   const double r = settings.r_sphere;
   const Eigen::Vector3d t0_from_c = t0 - c;
@@ -752,6 +774,9 @@ IterationResult iterate(const OcclusionRays& occ, const Eigen::Vector3d& start,
     best.consider(t, proj.in_clearance, angle_between(t_from_c, t0_from_c));
     if (i == settings.max_iterations) {
       return {best.t(), ViewStatus::NotConverged, i, best.count()};
+    }
+    if (i % 8 == 7 && Clock::now() > deadline) {
+      return {best.t(), ViewStatus::OutOfTime, i, best.count()};
     }
     const Eigen::Vector3d push = push_direction(proj, occ, t_from_c, r, object.e);
     t = step_on_sphere(t, push, c, r, settings.step);
@@ -796,6 +821,8 @@ Eigen::Vector3d sphere_exit(const Eigen::Vector3d& centre, double radius,
 
 ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& settings,
                            const EstimateOptions& options) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(settings.time_budget));
   check_inputs(problem, settings);
   const double r = settings.r_sphere;
 
@@ -832,10 +859,16 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
     est.tf = est.t0;
     if (options.record_path) est.path.push_back(est.t0);
   } else {
+    const double n_rays = static_cast<double>(rays.v.cols()) * static_cast<double>(q.cols());
+    if (n_rays > kMaxOcclusionRays) {
+      usage_error(std::to_string(rays.v.cols()) + " supervoxels x " + std::to_string(q.cols()) +
+                  " occluders make " + format_value(n_rays) + " occlusion rays, more than the " +
+                  format_value(kMaxOcclusionRays) + " ofv handles: thin the supervoxels or the occluders");
+    }
     const OcclusionRays occ = occlusion_rays(c, r, rays.v, q);
     est.occlusion_points = static_cast<int>(occ.size());
     const IterationResult it =
-        iterate(occ, start, est.t0, object, settings, options.record_path ? &est.path : nullptr);
+        iterate(occ, start, est.t0, object, settings, deadline, options.record_path ? &est.path : nullptr);
     est.tf = it.tf;
     est.status = it.status;
     est.iterations = it.iterations;
@@ -846,6 +879,13 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   est.error_t0 = angular_error(rays.u, est.t0 - c);
   est.error_tf = angular_error(rays.u, est.tf - c);
   est.tf_to_t0_deg = angle_between(est.tf - c, est.t0 - c) * kRadToDeg;
+  // Geometry never lies: a view is finite and on the sphere.
+  for (const Eigen::Vector3d* t : {&est.t0, &est.tf}) {
+    if (!t->allFinite() || std::abs((*t - c).norm() - r) > 1e-6 * r) {
+      throw std::logic_error("estimate_view: a view off the sphere (" + format_value(*t) + ", radius " +
+                             format_value(r) + " around " + format_value(c) + "): please report this input");
+    }
+  }
   return est;
 }
 

@@ -17,9 +17,9 @@ using detail::usage_error;
 namespace {
 
 void require_positive(const char* name, double value) {
-  if (!std::isfinite(value) || value <= 0.0) {
-    usage_error(std::string("parameter '") + name + "' must be finite and positive, got " +
-                format_value(value));
+  if (!std::isfinite(value) || value <= 0.0 || value > kMaxLength) {
+    usage_error(std::string("parameter '") + name + "' must be positive and at most " + format_value(kMaxLength) +
+                " m, got " + format_value(value));
   }
 }
 
@@ -34,6 +34,9 @@ void validate(const EstimatorSettings& s) {
   if (s.max_iterations < 0) {
     usage_error("parameter 'max_iterations' must be a non-negative integer, got " +
                 std::to_string(s.max_iterations));
+  }
+  if (!(s.time_budget > 0.0 && s.time_budget <= 3600.0)) {
+    usage_error("parameter 'time_budget' must be in (0, 3600] s, got " + format_value(s.time_budget));
   }
 }
 
@@ -62,6 +65,7 @@ EstimatorSettings EstimatorParams::resolve() const {
   s.step = step.value_or(s.step);
   s.max_iterations = max_iterations.value_or(s.max_iterations);
   s.warm_start = warm_start.value_or(s.warm_start);
+  s.time_budget = time_budget.value_or(s.time_budget);
   validate(s);
   return s;
 }
@@ -77,6 +81,7 @@ const char* to_string(ViewStatus v) {
   switch (v) {
     case ViewStatus::Converged: return "converged";
     case ViewStatus::NotConverged: return "not_converged";
+    case ViewStatus::OutOfTime: return "out_of_time";
     case ViewStatus::NoOccluders: return "no_occluders";
     case ViewStatus::NoSupervoxels: return "no_supervoxels";
   }
@@ -159,6 +164,10 @@ SettingsTable<EstimatorParams> make_table() {
         [](P& p, const std::string& v) { p.max_iterations = static_cast<int>(parse_integer("max_iterations", v, 0, INT_MAX)); });
   t.add({"warm_start", "bool", format_bool(d.warm_start), "", "start from the previous frame's view instead of t0"},
         [](P& p, const std::string& v) { p.warm_start = parse_bool("warm_start", v); });
+  t.add({"time_budget", "number > 0", format_number(d.time_budget), "s",
+         "wall time one estimate may take (ofv's bound, not the spec's): then the best visited view, status "
+         "out_of_time; up to 3600"},
+        [](P& p, const std::string& v) { p.time_budget = parse_number("time_budget", v, 0.0, 3600.0, true); });
   return t;
 }
 

@@ -315,6 +315,57 @@ TEST(Estimator, InvalidSettingsNameTheParameter) {
   s = {};
   s.max_iterations = -1;
   EXPECT_NE(message_for(s).find("max_iterations"), std::string::npos);
+  // Extreme but finite lengths are refused, not turned into a view at C or NaN.
+  for (double* length : {&s.r_seed, &s.r_sphere, &s.clearance, &s.push_radius, &s.step}) {
+    s = {};
+    *length = 1e300;
+    EXPECT_NE(message_for(s).find("at most 10000 m"), std::string::npos);
+  }
+  s = {};
+  s.time_budget = 0.0;
+  EXPECT_NE(message_for(s).find("time_budget"), std::string::npos);
+}
+
+TEST(Estimator, ExtremeCoordinatesAndHugeProblemsAreRefused) {
+  ViewProblem p = single_supervoxel();
+  p.occluders = cols({{0, 0, 0.2}, {0, 0, 1e308}});
+  try {
+    (void)estimate_view(p, EstimatorSettings{});
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("occluder 1 has a coordinate beyond"), std::string::npos) << e.what();
+  }
+  p = single_supervoxel();
+  p.camera = Eigen::Vector3d(0, 0, -2e4);
+  EXPECT_THROW((void)estimate_view(p, EstimatorSettings{}), std::invalid_argument);
+  // 4000 x 4000 occlusion rays would take 384 MB: refused before any is made.
+  p = patch(80, 50, 0.001);
+  p.occluders = Eigen::Matrix3Xd::Constant(3, 4000, 0.2);
+  try {
+    (void)estimate_view(p, EstimatorSettings{});
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("4000 supervoxels x 4000 occluders"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Estimator, TheTimeBudgetEndsTheIterationWithTheBestIterate) {
+  // The scene of NotConvergedReturnsTheBestVisitedIterate, which never
+  // clears and does not cycle within 10^9 steps of 1 nm.
+  ViewProblem p = patch(4, 3, 0.03);
+  p.occluders = cols({{0.0, 0.0, 0.8}, {0.05, 0.0, 0.8}, {-0.05, 0.0, 0.8}, {0.0, 0.05, 0.8}});
+  EstimatorSettings s;
+  s.clearance = 0.1;
+  s.step = 1e-9;
+  s.max_iterations = std::numeric_limits<int>::max();
+  s.time_budget = 0.05;
+  const ViewEstimate e = estimate_view(p, s);
+  EXPECT_EQ(e.status, ViewStatus::OutOfTime);
+  EXPECT_GT(e.iterations, 0);
+  EXPECT_LT(e.iterations, s.max_iterations);
+  EXPECT_TRUE(e.tf.allFinite());
+  EXPECT_NEAR((e.tf - e.centroid).norm(), s.r_sphere, 1e-9);
+  EXPECT_FALSE(is_free(e.status));
 }
 
 TEST(Estimator, GivenAxesMustBeFiniteAndNonZero) {

@@ -51,7 +51,7 @@ TEST(SettingsTable, UnknownNamesListTheKnownOnes) {
 TEST(SettingsTable, EstimatorDefaultsComeFromTheSettingsStruct) {
   const EstimatorSettings d;
   const auto docs = estimator_settings_table().docs();
-  ASSERT_EQ(docs.size(), 10U);
+  ASSERT_EQ(docs.size(), 11U);
   for (const auto& doc : docs) {
     EstimatorParams p;
     estimator_settings_table().set(p, doc.name, doc.default_value);

@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     // 4. The camera pose that goes with tf: optical axis from tf to C (spec §5).
     const Eigen::Vector3d z_axis = (view.centroid - view.tf).normalized();
     std::cout << "optical axis at tf  " << z_axis.transpose() << '\n';
-    return view.status == ofv::ViewStatus::NotConverged ? 1 : 0;
+    return ofv::is_free(view.status) ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "tutorial-estimate-view: " << e.what() << '\n';
     return 2;

@@ -49,6 +49,7 @@ enum class Preset {
 enum class ViewStatus {
   Converged,     ///< t_f has no projected occlusion point within `clearance`
   NotConverged,  ///< max_iterations reached; t_f is the best visited iterate
+  OutOfTime,     ///< time_budget ran out first; t_f is the best visited iterate
   NoOccluders,   ///< no valid occluder: t_f = t0
   /// No usable supervoxel (all skipped by spec §7) and no given centroid, so
   /// neither C nor a view exists: t0 = tf = the camera position if given, else
@@ -77,7 +78,20 @@ struct EstimatorSettings {
   double step = 0.02;          ///< length of one push on the tangent plane [m]
   int max_iterations = 500;    ///< push steps before giving up (>= 0)
   bool warm_start = false;     ///< start from the previous frame's view instead of t0
+  /// Wall time one estimate may take [s] (not the spec's: ofv's bound on
+  /// work). When it runs out the iteration ends with the best visited
+  /// iterate and status OutOfTime. The loop's frames take about 1 ms.
+  double time_budget = 1.0;
 };
+
+/// Lengths (r_seed, r_sphere, clearance, push_radius, step) and input
+/// coordinates beyond this are refused [m]: the arithmetic stays far from overflow.
+inline constexpr double kMaxLength = 1e4;
+/// More occlusion rays (usable supervoxels x occluders, spec §3) than this
+/// are refused (24 bytes each: 240 MB): thin the supervoxels or occluders.
+inline constexpr double kMaxOcclusionRays = 1e7;
+/// \brief true for the statuses whose t_f is free of occlusion (converged, no occluders).
+[[nodiscard]] inline bool is_free(ViewStatus s) { return s == ViewStatus::Converged || s == ViewStatus::NoOccluders; }
 
 /**
  * \brief Settings as a user states them: a preset plus explicit overrides.
@@ -96,6 +110,7 @@ struct EstimatorParams {
   std::optional<double> step;
   std::optional<int> max_iterations;
   std::optional<bool> warm_start;
+  std::optional<double> time_budget;
 
   /// \brief The settings these parameters stand for.
   /// \throws std::invalid_argument naming the parameter and value that break spec §7.
@@ -103,7 +118,8 @@ struct EstimatorParams {
 };
 
 /// \brief Throws std::invalid_argument, naming the parameter and its value,
-/// unless every length is finite and positive and max_iterations >= 0.
+/// unless every length is finite, positive and at most kMaxLength,
+/// max_iterations >= 0 and time_budget in (0, 3600] s.
 void validate(const EstimatorSettings& settings);
 
 /**

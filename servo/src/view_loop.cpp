@@ -286,12 +286,12 @@ std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& proble
     EstimatorSettings warm = estimator_;
     warm.warm_start = true;
     const ViewEstimate kept = estimate_view(from_previous, warm);
-    if (kept.status != ViewStatus::NotConverged) {
+    if (is_free(kept.status)) {
       status = kept.status;
       target = kept.tf;
     }
   }
-  if (status == ViewStatus::NotConverged && settings_.no_free_view.mode == NoFreeView::MostVisible) {
+  if (!is_free(status) && settings_.no_free_view.mode == NoFreeView::MostVisible) {
     // No free view: hold, or climb towards a view that sees clearly more.
     std::vector<Eigen::Vector3d> others{estimate.tf, estimate.t0};
     if (previous_target_) others.push_back(*previous_target_);
@@ -328,7 +328,8 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
   if (out.estimate) {
     switch (out.estimate->status) {
       case ViewStatus::Converged: out.status = StepStatus::Converged; break;
-      case ViewStatus::NotConverged: out.status = StepStatus::NotConverged; break;
+      case ViewStatus::NotConverged:
+      case ViewStatus::OutOfTime: out.status = StepStatus::NotConverged; break;
       default: out.status = StepStatus::NoOccluders; break;
     }
     const ViewProblem* basis = &*problem;
@@ -340,7 +341,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
         ahead.occluders.resize(3, problem->occluders.cols() + future.cols());
         ahead.occluders << problem->occluders, future;
         ViewEstimate anticipated = estimate_view(ahead, estimator_);
-        if (anticipated.status != ViewStatus::NotConverged) {
+        if (is_free(anticipated.status)) {
           out.predicted_occluders = future.cols();
           out.anticipated = std::move(anticipated);
           basis = &ahead;
