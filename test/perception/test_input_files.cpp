@@ -1,0 +1,97 @@
+// End to end: recorded input files that are broken, hostile or lying about
+// their content make `ofv perceive` exit 2 with one line naming the file,
+// never crash it (issue #13, item 1).
+#include "ofv/sources/pcd_sequence.h"
+
+#include "cli_run.h"
+#include "synthetic_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace ofv {
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void spit(const fs::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+std::vector<RgbdFrame> two_frames() {
+  std::vector<RgbdFrame> frames;
+  for (int k = 0; k < 2; ++k) {
+    frames.push_back(test::table_and_case().render(test::vga(160), test::front_camera(), nullptr,
+                                                   k / 30.0));
+  }
+  return frames;
+}
+
+/// Expects exit 2, one line on stderr naming every word of `mentions`, no crash.
+void expect_bad_input(const std::string& args, const std::vector<std::string>& mentions,
+                      const std::string& label) {
+  const CommandRun r = run(args);
+  EXPECT_EQ(r.code, 2) << label << ": " << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << label << ": " << r.err;
+  for (const std::string& m : mentions) {
+    EXPECT_NE(r.err.find(m), std::string::npos) << label << ": " << r.err;
+  }
+}
+
+TEST(InputFiles, BrokenPcdFramesAreExitTwoNamingTheFile) {
+  const fs::path dir = fs::path(test::scratch_dir()) / "ofv_bad_pcd";
+  fs::remove_all(dir);
+  {
+    PcdSequenceWriter writer(dir.string());
+    for (const RgbdFrame& f : two_frames()) {
+      writer.write(f);
+    }
+  }
+  const fs::path frame = dir / "000001.pcd";
+  const std::string good = slurp(frame);
+  ASSERT_EQ(run("perceive " + dir.string()).code, 0);
+  const std::size_t data = good.find("DATA binary\n") + 12;
+  const std::string header = good.substr(0, data);
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string h = header;
+    h.replace(h.find(from), from.size(), to);
+    return h + good.substr(data);
+  };
+  const std::string ascii_head =
+      "VERSION .7\nFIELDS x y z rgba\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 2\n"
+      "HEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA ascii\n";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"empty", ""},
+      {"garbage", std::string("\x89\x00\xff garbage\n\x01\x02", 16)},
+      {"truncated", good.substr(0, data + (good.size() - data) / 2)},
+      {"header only", header},
+      {"points not width x height", replaced("POINTS 19200", "POINTS 19199")},
+      {"a billion points", replaced("WIDTH 160", "WIDTH 6250000")},
+      {"no colour", replaced("FIELDS x y z rgba", "FIELDS x y z w")},
+      {"x not a float", replaced("TYPE F F F U", "TYPE U F F U")},
+      {"sizes missing", replaced("SIZE 4 4 4 4", "SIZE 4 4 4")},
+      {"compressed lies", replaced("DATA binary", "DATA binary_compressed")},
+      {"ascii garbage", ascii_head + "nan nan x\n1 2\n"},
+      {"ascii short", ascii_head + "1 2 3 4\n"},
+  };
+  for (const auto& [label, bytes] : cases) {
+    spit(frame, bytes);
+    expect_bad_input("perceive " + dir.string(), {"000001.pcd"}, label);
+  }
+}
+
+}  // namespace
+}  // namespace ofv
