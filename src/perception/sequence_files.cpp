@@ -94,8 +94,10 @@ CameraIntrinsics read_intrinsics_file(const std::string& path) {
     std::istringstream fields(line);
     CameraIntrinsics k;
     if (!(fields >> k.width >> k.height >> k.fx >> k.fy >> k.cx >> k.cy) || k.width <= 0 ||
-        k.height <= 0 || !(k.fx > 0.0) || !(k.fy > 0.0)) {
-      throw std::runtime_error(path + ": expected 'width height fx fy cx cy', got '" + line + "'");
+        k.height <= 0 || k.width > kMaxImageSide || k.height > kMaxImageSide || !std::isfinite(k.cx) || !std::isfinite(k.cy) ||
+        !std::isfinite(k.fx) || !std::isfinite(k.fy) || !(k.fx > 0.0) || !(k.fy > 0.0)) {
+      throw std::runtime_error(path + ": expected 'width height fx fy cx cy' (sizes 1 to " +
+                               std::to_string(kMaxImageSide) + ", focal lengths > 0), got '" + line + "'");
     }
     found = k;
   });

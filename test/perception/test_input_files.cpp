@@ -2,13 +2,17 @@
 // their content make `ofv perceive` exit 2 with one line naming the file,
 // never crash it (issue #13, item 1).
 #include "ofv/sources/pcd_sequence.h"
+#include "ofv/sources/tum_sequence.h"
 
 #include "cli_run.h"
 #include "synthetic_scene.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -91,6 +95,75 @@ TEST(InputFiles, BrokenPcdFramesAreExitTwoNamingTheFile) {
     spit(frame, bytes);
     expect_bad_input("perceive " + dir.string(), {"000001.pcd"}, label);
   }
+}
+
+/// A PNG with its IHDR size set to `width` x `height` (CRC updated), pixels unchanged.
+std::string with_png_size(std::string png, std::uint32_t width, std::uint32_t height) {
+  for (int k = 0; k < 4; ++k) {
+    png[16 + k] = static_cast<char>(width >> (24 - 8 * k));
+    png[20 + k] = static_cast<char>(height >> (24 - 8 * k));
+  }
+  std::uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of the chunk type and data (bytes 12 to 28)
+  for (int i = 12; i < 29; ++i) {
+    crc ^= static_cast<std::uint8_t>(png[i]);
+    for (int b = 0; b < 8; ++b) {
+      crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+  }
+  crc = ~crc;
+  for (int k = 0; k < 4; ++k) {
+    png[29 + k] = static_cast<char>(crc >> (24 - 8 * k));
+  }
+  return png;
+}
+
+TEST(InputFiles, BrokenTumImagesAndPosesAreExitTwoNamingTheFile) {
+  const fs::path dir = fs::path(test::scratch_dir()) / "ofv_bad_tum";
+  fs::remove_all(dir);
+  {
+    TumSequenceWriter writer(dir.string());
+    for (const RgbdFrame& f : two_frames()) {
+      writer.write(f);
+    }
+  }
+  ASSERT_EQ(run("perceive " + dir.string()).code, 0);
+  const fs::path depth = dir / "depth" / "0.033333.png";
+  const fs::path rgb = dir / "rgb" / "0.033333.png";
+  const std::string good_depth = slurp(depth), good_rgb = slurp(rgb);
+  std::string corrupt = good_depth;
+  for (std::size_t i = 60; i + 20 < corrupt.size(); i += 7) {
+    corrupt[i] = static_cast<char>(corrupt[i] ^ 0x55);
+  }
+  const fs::path rgb16 = dir / "rgb16.png";
+  ASSERT_TRUE(cv::imwrite(rgb16.string(), cv::Mat(120, 160, CV_16UC3, cv::Scalar(1000, 2000, 3000))));
+  struct Case {
+    std::string label;
+    fs::path file;
+    std::string bytes;
+    std::vector<std::string> mentions;
+  };
+  const std::vector<Case> cases{
+      {"corrupt depth", depth, corrupt, {depth.string(), "corrupt"}},
+      {"text depth", depth, "not a png\n", {depth.string()}},
+      {"empty depth", depth, "", {depth.string()}},
+      {"16-bit RGB depth", depth, slurp(rgb16), {depth.string(), "16-bit RGB"}},
+      {"8-bit RGB depth", depth, good_rgb, {depth.string(), "8-bit RGB"}},
+      {"30000 x 30000 depth", depth, with_png_size(good_depth, 30000, 30000), {depth.string(), "30000x30000"}},
+      {"corrupt colour", rgb, corrupt, {rgb.string()}},
+      {"30000 x 30000 colour", rgb, with_png_size(good_rgb, 30000, 30000), {rgb.string(), "30000x30000"}},
+  };
+  for (const Case& c : cases) {
+    spit(c.file, c.bytes);
+    expect_bad_input("perceive " + dir.string(), c.mentions, c.label);
+    spit(depth, good_depth);
+    spit(rgb, good_rgb);
+  }
+  // A depth image without a ground-truth pose near its time.
+  const std::string poses = slurp(dir / "groundtruth.txt");
+  spit(dir / "groundtruth.txt", poses.substr(0, poses.rfind('\n', poses.size() - 2) + 1));
+  expect_bad_input("perceive " + dir.string(), {"groundtruth.txt", "0.033333"}, "missing pose");
+  fs::remove(dir / "groundtruth.txt");
+  expect_bad_input("perceive " + dir.string(), {"groundtruth.txt", "missing"}, "no ground truth");
 }
 
 }  // namespace

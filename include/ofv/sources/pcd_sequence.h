@@ -26,8 +26,8 @@
 
 namespace ofv {
 
-/// \brief Largest number of points of one PCD frame (4096 x 4096).
-constexpr std::uint64_t kMaxPcdPoints = std::uint64_t{4096} * 4096;
+/// \brief Largest number of points of one PCD frame (kMaxImageSide squared).
+constexpr std::uint64_t kMaxPcdPoints = std::uint64_t{kMaxImageSide} * kMaxImageSide;
 
 /// \brief Reads a PCD sequence frame by frame (see the file comment for the layout).
 class PcdSequenceSource : public FrameSource {

@@ -16,6 +16,9 @@
 
 namespace ofv {
 
+/// \brief Largest image side [px] of a recorded sequence (images, intrinsics, PCD rows).
+constexpr int kMaxImageSide = 4096;
+
 /**
  * rief Calls `f(line, number)` for each data line of a sequence text file:
  *        blank lines and `#` comments are skipped; numbers count from 1.
@@ -49,7 +52,8 @@ struct StampedPose {
                                                  double time);
 
 /**
- * \brief Reads `width height fx fy cx cy` (one line, `#` comments) [px].
+ * \brief Reads `width height fx fy cx cy` (one line, `#` comments) [px]; width and
+ *        height at most kMaxImageSide.
  * \throws std::runtime_error naming the file when it cannot be read or parsed.
  */
 [[nodiscard]] CameraIntrinsics read_intrinsics_file(const std::string& path);
