@@ -37,9 +37,14 @@ std::vector<StampedPose> read_pose_file(const std::string& path) {
                                ": expected 't tx ty tz qx qy qz qw', got '" + line + "'");
     }
     const Eigen::Quaterniond q(qw, qx, qy, qz);
-    if (!(q.norm() > 1e-6) || !std::isfinite(q.norm()) || !std::isfinite(tx + ty + tz + t)) {
+    if (!std::isfinite(tx + ty + tz + t)) {
       throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose '" + line +
                                "'");
+    }
+    if (!(std::abs(q.norm() - 1.0) <= kQuaternionTolerance)) {
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": quaternion norm " +
+                               std::to_string(q.norm()) + ", expected 1 +- " +
+                               std::to_string(kQuaternionTolerance));
     }
     StampedPose p;
     p.time = t;

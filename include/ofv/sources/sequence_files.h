@@ -34,8 +34,13 @@ struct StampedPose {
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
 };
 
+/// \brief Largest difference from 1 of a pose file's quaternion norm (files
+/// written with 4 decimals are within 2e-4); the quaternion is then normalised.
+constexpr double kQuaternionTolerance = 1e-3;
+
 /**
- * \brief Reads a TUM pose file: `t tx ty tz qx qy qz qw` per line, `#` comments.
+ * \brief Reads a TUM pose file: `t tx ty tz qx qy qz qw` per line, `#` comments;
+ *        the quaternion of unit norm within kQuaternionTolerance.
  * \throws std::runtime_error naming the file and line when it cannot be read or parsed.
  */
 [[nodiscard]] std::vector<StampedPose> read_pose_file(const std::string& path);
