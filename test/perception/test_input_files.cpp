@@ -1,6 +1,7 @@
 // End to end: recorded input files that are broken, hostile or lying about
 // their content make `ofv perceive` exit 2 with one line naming the file,
 // never crash it (issue #13, item 1).
+#include "ofv/sources/openni2_source.h"
 #include "ofv/sources/pcd_sequence.h"
 #include "ofv/sources/tum_sequence.h"
 
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -164,6 +166,67 @@ TEST(InputFiles, BrokenTumImagesAndPosesAreExitTwoNamingTheFile) {
   expect_bad_input("perceive " + dir.string(), {"groundtruth.txt", "0.033333"}, "missing pose");
   fs::remove(dir / "groundtruth.txt");
   expect_bad_input("perceive " + dir.string(), {"groundtruth.txt", "missing"}, "no ground truth");
+}
+
+TEST(InputFiles, OniWithAnyHeaderByteChangedIsRefusedOrPlays) {
+  const fs::path good_path = fs::path(test::scratch_dir()) / "ofv_good.oni";
+  {
+    OniWriter writer(good_path.string());
+    for (const RgbdFrame& f : two_frames()) {
+      writer.write(f);
+    }
+  }
+  const std::string good = slurp(good_path);
+  ASSERT_NO_THROW(check_oni_file(good_path.string()));
+  // Every byte but the frames' pixels: the file header, record headers and fields.
+  std::vector<bool> header_byte(good.size(), true);
+  for (std::size_t at = 24; at + 28 <= good.size();) {
+    std::uint32_t type = 0, fields = 0, payload = 0;
+    std::memcpy(&type, good.data() + at + 4, 4);
+    std::memcpy(&fields, good.data() + at + 12, 4);
+    std::memcpy(&payload, good.data() + at + 16, 4);
+    std::fill_n(header_byte.begin() + static_cast<std::ptrdiff_t>(at + fields), payload, false);
+    at += fields + payload;
+    if (type == 0x0B) {
+      break;
+    }
+  }
+  const fs::path path = fs::path(test::scratch_dir()) / "ofv_mutated.oni";
+  int refused = 0, played = 0;
+  std::vector<std::size_t> refused_offsets;
+  for (std::size_t k = 0; k < good.size(); ++k) {
+    if (!header_byte[k]) {
+      continue;
+    }
+    std::string bytes = good;
+    bytes[k] = static_cast<char>(bytes[k] ^ 0xFF);
+    spit(path, bytes);
+    try {
+      check_oni_file(path.string());
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(path.string() + ": offset "), std::string::npos) << e.what();
+      ++refused;
+      refused_offsets.push_back(k);
+      continue;
+    }
+    // Accepted: OpenNI2 plays it, or reports an error; it must not crash.
+    try {
+      OpenNi2Source source(path.string());
+      while (source.next()) {
+      }
+    } catch (const std::exception&) {
+    }
+    ++played;
+  }
+  EXPECT_GT(refused, 0);
+  std::cerr << refused << " mutations refused, " << played << " played\n";
+  // Through the command line: exit 2, one line naming the file and the offset.
+  for (const std::size_t k : {std::size_t{0}, std::size_t{20}, std::size_t{24 + 12}, refused_offsets.back()}) {
+    std::string bytes = good;
+    bytes[k] = static_cast<char>(bytes[k] ^ 0xFF);
+    spit(path, bytes);
+    expect_bad_input("perceive " + path.string(), {path.string(), "offset"}, "byte " + std::to_string(k));
+  }
 }
 
 }  // namespace
