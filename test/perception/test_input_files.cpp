@@ -81,7 +81,7 @@ TEST(InputFiles, BrokenPcdFramesAreExitTwoNamingTheFile) {
       "HEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA ascii\n";
   const std::vector<std::pair<std::string, std::string>> cases{
       {"empty", ""},
-      {"garbage", std::string("\x89\x00\xff garbage\n\x01\x02", 16)},
+      {"garbage", std::string("\x89\x00\xff garbage\n\x01\x02", 14)},
       {"truncated", good.substr(0, data + (good.size() - data) / 2)},
       {"header only", header},
       {"points not width x height", replaced("POINTS 19200", "POINTS 19199")},
@@ -219,6 +219,11 @@ TEST(InputFiles, OniWithAnyHeaderByteChangedIsRefusedOrPlays) {
     ++played;
   }
   EXPECT_GT(refused, 0);
+  // Fewer poses than frames: no frame silently takes the last pose.
+  const std::string poses = slurp(good_path.string() + ".poses.txt");
+  spit(good_path.string() + ".poses.txt", poses.substr(0, poses.rfind('\n', poses.size() - 2) + 1));
+  expect_bad_input("perceive " + good_path.string(), {good_path.string() + ".poses.txt", "1 poses for 2 frames"},
+                   "missing pose");
   std::cerr << refused << " mutations refused, " << played << " played\n";
   // Through the command line: exit 2, one line naming the file and the offset.
   for (const std::size_t k : {std::size_t{0}, std::size_t{20}, std::size_t{24 + 12}, refused_offsets.back()}) {
