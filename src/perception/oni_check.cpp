@@ -26,6 +26,7 @@ using namespace oni;
 /// What the records said so far about one node.
 struct NodeState {
   bool added = false;
+  bool ready = false;  // NODE_STATE_READY: the player reads on until every added node is ready
   bool begun = false;
   std::uint32_t codec = 0;
   std::uint32_t frames = 0;      // as NODE_ADDED claims
@@ -262,8 +263,11 @@ void check_oni_file(const std::string& path) {
         break;
       case kNodeStateReady:
         f.end();
+        if (n.ready) fail(at + 8, "node " + std::to_string(id) + " ready twice");
+        n.ready = true;
         break;
       case kNodeDataBegin:
+        if (!n.ready || n.begun) fail(at + 8, "data of node " + std::to_string(id) + " begins before it is ready, or twice");
         (void)f.get<std::uint32_t>("frame count");
         (void)f.get<std::uint64_t>("max timestamp");
         f.end();
@@ -271,6 +275,9 @@ void check_oni_file(const std::string& path) {
         break;
       case kNewData: {
         if (!n.begun) fail(at + 8, "data of node " + std::to_string(id) + " before its DATA_BEGIN");
+        for (std::size_t other = 0; other < nodes.size(); ++other) {
+          if (nodes[other].added && !nodes[other].ready) fail(at, "data before node " + std::to_string(other) + " is ready");
+        }
         const auto time = f.get<std::uint64_t>("timestamp");
         const std::uint64_t frame_at = f.here();
         const auto frame = f.get<std::uint32_t>("frame number");
