@@ -4,6 +4,7 @@
 #include "ofv/loop/frame_files.h"
 #include "ofv/sim/renderer.h"
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -43,7 +44,9 @@ Command add_render_command(CLI::App& app) {
             Eigen::Isometry3d wMc;
             try {
               scenario = sim::load_scenario(opt->scenario);
-              if (!(opt->time >= 0.0)) throw std::invalid_argument("--time must be >= 0");
+              if (!(opt->time >= 0.0) || opt->time > 3600.0) {
+                throw std::invalid_argument("--time " + std::to_string(opt->time) + ": expected a time in [0, 3600] s");
+              }
               k = scenario.sensor.intrinsics;
               if (!opt->size.empty()) {
                 int w = 0, h = 0;
@@ -61,6 +64,13 @@ Command add_render_command(CLI::App& app) {
               }
               wMc = scenario.wMc_start;
               if (!opt->pose.empty()) {
+                // Embree aborts on non-finite rays: every value finite, positions within 1 km.
+                for (std::size_t i = 0; i < opt->pose.size(); ++i) {
+                  if (!(std::abs(opt->pose[i]) <= 1e3)) {
+                    throw std::invalid_argument("--pose: value " + std::to_string(i + 1) + " is " +
+                                                std::to_string(opt->pose[i]) + ", expected a finite number in [-1000, 1000]");
+                  }
+                }
                 const Eigen::Vector3d tu(opt->pose[3], opt->pose[4], opt->pose[5]);
                 wMc = Eigen::Isometry3d::Identity();
                 if (tu.norm() > 0.0) wMc.linear() = Eigen::AngleAxisd(tu.norm(), tu.normalized()).toRotationMatrix();

@@ -227,6 +227,9 @@ Command add_run_command(CLI::App& app) {
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
                         << (summary.stopped ? ", stopped by a signal" : "") << '\n';
               return kOk;
+            } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims
+              std::cerr << "ofv run: " << e.what() << '\n';
+              return kUsage;
             } catch (const std::exception& e) {
               std::cerr << "ofv run: " << e.what() << '\n';
               return kRuntimeFailure;

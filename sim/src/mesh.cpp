@@ -6,13 +6,101 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 
 namespace ofv::sim {
 
 namespace {
+
+/**
+ * Checks a PLY header before Assimp reads the file (Assimp aborts on truncated
+ * files and spends minutes on headers that claim 10^8 vertices): the element
+ * counts within the limits, and count x the fewest bytes of an element (a face
+ * has 3 indices at least) inside the file.
+ */
+void check_ply_header(const std::string& path) {
+  const auto fail = [&](const std::string& what) {
+    throw std::runtime_error(path + ": invalid PLY header: " + what);
+  };
+  std::ifstream in(path, std::ios::binary);
+  std::string line, format;
+  std::getline(in, line);
+  if (line != "ply" && line != "ply\r") fail("the first line is not 'ply'");
+  struct Element {
+    std::string name;
+    std::uint64_t count = 0;
+    std::uint64_t min_bytes = 0;
+  };
+  std::vector<Element> elements;
+  const std::map<std::string, std::uint64_t> sizes{
+      {"char", 1},  {"uchar", 1},  {"int8", 1},    {"uint8", 1},   {"short", 2},
+      {"ushort", 2}, {"int16", 2}, {"uint16", 2},  {"int", 4},     {"uint", 4},
+      {"int32", 4},  {"uint32", 4}, {"float", 4},  {"float32", 4}, {"double", 8},
+      {"float64", 8}};
+  const auto size_of = [&](const std::string& type) {
+    const auto it = sizes.find(type);
+    if (it == sizes.end()) fail("unknown property type '" + type.substr(0, 20) + "'");
+    return it->second;
+  };
+  while (std::getline(in, line) && line.rfind("end_header", 0) != 0) {
+    if (in.tellg() > 65536) fail("no end_header in the first 64 KiB");
+    std::istringstream words(line);
+    std::string key;
+    words >> key;
+    if (key == "format") {
+      words >> format;
+    } else if (key == "element") {
+      Element e;
+      std::string count;
+      words >> e.name >> count;
+      if (count.empty() || count.size() > 12 || count.find_first_not_of("0123456789") != std::string::npos) {
+        fail("element " + e.name.substr(0, 20) + ": count '" + count.substr(0, 20) + "'");
+      }
+      e.count = std::stoull(count);
+      elements.push_back(e);
+    } else if (key == "property") {
+      if (elements.empty()) fail("a property before any element");
+      Element& e = elements.back();
+      std::string type, count_type, item_type, name;
+      words >> type;
+      const bool ascii = format == "ascii";
+      if (type == "list") {
+        words >> count_type >> item_type >> name;
+        const std::uint64_t items = name == "vertex_indices" || name == "vertex_index" ? 3 : 0;
+        e.min_bytes += ascii ? 2 + 2 * items : size_of(count_type) + items * size_of(item_type);
+      } else {
+        e.min_bytes += ascii ? 2 : size_of(type);
+      }
+    }
+  }
+  if (!in) fail("no end_header");
+  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
+    fail("format '" + format.substr(0, 30) + "'");
+  }
+  const auto start = static_cast<std::uint64_t>(in.tellg());
+  const std::uint64_t file_size = std::filesystem::file_size(path);
+  std::uint64_t needed = 0;
+  for (const Element& e : elements) {
+    const std::uint64_t limit = e.name == "vertex" ? kMaxMeshVertices : kMaxMeshTriangles;
+    if (e.count > limit) {
+      fail("element " + e.name.substr(0, 20) + " " + std::to_string(e.count) + ": more than " +
+           std::to_string(limit));
+    }
+    needed += e.count * e.min_bytes;  // <= 10^7 x (properties x 8): no overflow
+  }
+  if (needed > file_size - start) {
+    fail("the elements need " + std::to_string(needed) + " bytes at least, the file has " +
+         std::to_string(file_size - start) + " after the header");
+  }
+}
 
 
 // Flips triangles whose normal points towards `inside(centroid)`, the nearest
@@ -188,19 +276,41 @@ void deform_sheet(const TriangleMesh& rest, double amplitude, double wavelength,
 }
 
 TriangleMesh read_mesh(const std::string& path, double scale) {
-  const aiScene* scene =
-      aiImportFile(path.c_str(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) throw std::runtime_error(path + ": cannot read mesh (" + ec.message() + ")");
+  if (bytes > kMaxMeshFileBytes) {
+    throw std::runtime_error(path + ": " + std::to_string(bytes) + " bytes, more than " +
+                             std::to_string(kMaxMeshFileBytes));
+  }
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".ply") check_ply_header(path);
+  const aiScene* scene = aiImportFile(
+      path.c_str(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);
   if (scene == nullptr) {
     throw std::runtime_error(path + ": cannot read mesh (" + aiGetErrorString() + ")");
   }
   TriangleMesh m;
-  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+  std::string problem;
+  for (unsigned k = 0; k < scene->mNumMeshes && problem.empty(); ++k) {
     const aiMesh* mesh = scene->mMeshes[k];
     const int base = static_cast<int>(m.vertices.size());
+    if (m.vertices.size() + mesh->mNumVertices > kMaxMeshVertices) {
+      problem = "more than " + std::to_string(kMaxMeshVertices) + " vertices";
+      break;
+    }
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
       const aiVector3D& p = mesh->mVertices[v];
-      m.vertices.emplace_back(static_cast<float>(p.x * scale), static_cast<float>(p.y * scale),
+      const Eigen::Vector3f q(static_cast<float>(p.x * scale), static_cast<float>(p.y * scale),
                               static_cast<float>(p.z * scale));
+      if (!q.allFinite() || q.cwiseAbs().maxCoeff() > 1e4f) {  // Embree aborts on NaN and inf
+        problem = "vertex " + std::to_string(v) + " (" + std::to_string(p.x) + ", " +
+                  std::to_string(p.y) + ", " + std::to_string(p.z) + ") x scale " +
+                  std::to_string(scale) + " is not finite or beyond 10 km";
+        break;
+      }
+      m.vertices.push_back(q);
     }
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
@@ -212,6 +322,7 @@ TriangleMesh read_mesh(const std::string& path, double scale) {
     }
   }
   aiReleaseImport(scene);
+  if (!problem.empty()) throw std::runtime_error(path + ": " + problem);
   if (m.triangles.empty()) throw std::runtime_error(path + ": the mesh has no triangles");
   return m;
 }

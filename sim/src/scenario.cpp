@@ -3,6 +3,7 @@
 #include "ofv/constants.h"
 
 #include "ofv/io/scene_json.h"
+#include "ofv/sim/yaml_checks.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <set>
 #include <sstream>
@@ -24,6 +26,20 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kDegToRad = kPi / 180.0;
+
+// Upper bounds of the scenario's numbers (docs/scenarios.md, "Limits"): a
+// scenario file is input, and a typo must not allocate or loop for ever.
+constexpr std::uintmax_t kMaxFileBytes = 1 << 20;  // the YAML text
+constexpr double kMaxDuration = 3600.0;            // duration, |waypoint t| [s]
+constexpr double kMaxRate = 1000.0;                // frame rate [Hz]
+constexpr double kMaxLength = 100.0;               // positions, sizes, depths, wave length [m]
+constexpr double kMaxAngle = 3600.0;               // rpy_deg [deg]
+constexpr int kMaxImageSide = 4096;                // sensor width, height [px]
+constexpr double kMaxPixels = 1e5;                 // fx, fy, |cx|, |cy| [px]
+constexpr int kMaxGrid = 512;                      // cloth and sheet cells a side
+constexpr double kMaxScale = 1000.0;               // mesh scale
+constexpr double kMaxGain = 100.0;                 // controller gain [1/s]
+constexpr double kMaxSpeed = 10.0;                 // controller speed limits [m/s], [rad/s]
 
 // A YAML map read strictly: every key must be known, errors name file and key.
 class Node {
@@ -68,9 +84,9 @@ class Node {
     }
     return v;
   }
-  [[nodiscard]] double positive() const {
+  [[nodiscard]] double positive(double hi) const {
     const double v = number();
-    if (!(v > 0.0)) fail("expected a positive number, got " + value_text());
+    if (!(v > 0.0) || v > hi) fail("expected a number in (0, " + std::to_string(hi) + "], got " + value_text());
     return v;
   }
   [[nodiscard]] double in_range(double lo, double hi) const {
@@ -78,10 +94,10 @@ class Node {
     if (v < lo || v > hi) fail("expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + value_text());
     return v;
   }
-  [[nodiscard]] int integer(int lo) const {
-    int v = 0;
-    if (!node_.IsScalar() || !YAML::convert<int>::decode(node_, v) || v < lo) {
-      fail("expected an integer >= " + std::to_string(lo) + ", got " + value_text());
+  [[nodiscard]] int integer(int lo, int hi) const {
+    int v = 0;  // decode fails on values outside int's range
+    if (!node_.IsScalar() || !YAML::convert<int>::decode(node_, v) || v < lo || v > hi) {
+      fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + value_text());
     }
     return v;
   }
@@ -100,12 +116,13 @@ class Node {
     }
     return v;
   }
-  [[nodiscard]] Eigen::VectorXd vector(int n) const {
+  /// A list of n numbers in [-limit, limit].
+  [[nodiscard]] Eigen::VectorXd vector(int n, double limit) const {
     if (!node_.IsSequence() || static_cast<int>(node_.size()) != n) {
       fail("expected a list of " + std::to_string(n) + " numbers, got " + value_text());
     }
     Eigen::VectorXd v(n);
-    for (int k = 0; k < n; ++k) v(k) = item(static_cast<std::size_t>(k)).number();
+    for (int k = 0; k < n; ++k) v(k) = item(static_cast<std::size_t>(k)).in_range(-limit, limit);
     return v;
   }
   [[nodiscard]] const std::string& source() const { return source_; }
@@ -118,7 +135,7 @@ class Node {
 };
 
 Eigen::Vector3f colour(const Node& n) {
-  const Eigen::VectorXd c = n.vector(3);
+  const Eigen::VectorXd c = n.vector(3, 255.0);
   if ((c.array() < 0.0).any() || (c.array() > 255.0).any()) n.fail("expected R, G, B in [0, 255], got " + n.value_text());
   return (c / 255.0).cast<float>();
 }
@@ -127,8 +144,8 @@ Motion motion(const Node& n, const std::string& base_dir) {
   (void)base_dir;
   Motion m;
   Waypoint start;
-  if (n.has("position")) start.position = n.child("position").vector(3);
-  if (n.has("rpy_deg")) start.rpy_deg = n.child("rpy_deg").vector(3);
+  if (n.has("position")) start.position = n.child("position").vector(3, kMaxLength);
+  if (n.has("rpy_deg")) start.rpy_deg = n.child("rpy_deg").vector(3, kMaxAngle);
   if (!n.has("waypoints")) {
     m.waypoints.push_back(start);
     return m;
@@ -140,9 +157,9 @@ Motion motion(const Node& n, const std::string& base_dir) {
     p.require_map({"t", "position", "rpy_deg"});
     Waypoint wp = m.waypoints.empty() ? start : m.waypoints.back();
     if (!p.has("t")) p.fail("missing 't'");
-    wp.t = p.child("t").number();
-    if (p.has("position")) wp.position = p.child("position").vector(3);
-    if (p.has("rpy_deg")) wp.rpy_deg = p.child("rpy_deg").vector(3);
+    wp.t = p.child("t").in_range(-kMaxDuration, kMaxDuration);
+    if (p.has("position")) wp.position = p.child("position").vector(3, kMaxLength);
+    if (p.has("rpy_deg")) wp.rpy_deg = p.child("rpy_deg").vector(3, kMaxAngle);
     if (!m.waypoints.empty() && !(wp.t > m.waypoints.back().t)) p.child("t").fail("waypoint times must increase, got " + p.child("t").value_text());
     m.waypoints.push_back(wp);
   }
@@ -159,18 +176,18 @@ Body body(const Node& n, Role role, const std::string& default_name, const std::
   b.shape = n.child("shape").word({"box", "sphere", "capsule", "sheet", "cloth", "mesh"});
   auto size = [&](int k, const Eigen::VectorXd& def) -> Eigen::VectorXd {
     if (!n.has("size")) return def;
-    const Eigen::VectorXd s = n.child("size").vector(k);
+    const Eigen::VectorXd s = n.child("size").vector(k, kMaxLength);
     if (!(s.array() > 0.0).all()) n.child("size").fail("expected positive sizes, got " + n.child("size").value_text());
     return s;
   };
-  const double radius = n.has("radius") ? n.child("radius").positive() : 0.03;
-  const double length = n.has("length") ? n.child("length").positive() : 0.12;
-  const double thickness = n.has("thickness") ? n.child("thickness").positive() : 0.002;
+  const double radius = n.has("radius") ? n.child("radius").positive(kMaxLength) : 0.03;
+  const double length = n.has("length") ? n.child("length").positive(kMaxLength) : 0.12;
+  const double thickness = n.has("thickness") ? n.child("thickness").positive(kMaxLength) : 0.002;
   Eigen::Vector2i grid(16, 12);
   if (n.has("grid")) {
     const Node g = n.child("grid");
     if (!g.is_sequence() || g.size() != 2) g.fail("expected [nx, ny], got " + g.value_text());
-    grid = {g.item(0).integer(1), g.item(1).integer(1)};
+    grid = {g.item(0).integer(1, kMaxGrid), g.item(1).integer(1, kMaxGrid)};
   }
   if (b.shape == "box") {
     b.mesh = make_box(size(3, Eigen::Vector3d(0.19, 0.135, 0.015)));
@@ -185,7 +202,7 @@ Body body(const Node& n, Role role, const std::string& default_name, const std::
     if (!n.has("file")) n.fail("missing 'file' for a mesh");
     fs::path file = n.child("file").word({});
     if (file.is_relative()) file = fs::path(base_dir) / file;
-    const double scale = n.has("scale") ? n.child("scale").positive() : 1.0;
+    const double scale = n.has("scale") ? n.child("scale").positive(kMaxScale) : 1.0;
     try {
       b.mesh = read_mesh(file.string(), scale);
     } catch (const std::runtime_error& e) {
@@ -199,7 +216,7 @@ Body body(const Node& n, Role role, const std::string& default_name, const std::
     const Node w = n.child("wave");
     w.require_map({"amplitude", "length", "frequency"});
     if (w.has("amplitude")) b.wave_amplitude = w.child("amplitude").in_range(0.0, 1.0);
-    if (w.has("length")) b.wave_length = w.child("length").positive();
+    if (w.has("length")) b.wave_length = w.child("length").positive(kMaxLength);
     if (w.has("frequency")) b.wave_frequency = w.child("frequency").in_range(0.0, 100.0);
   }
   if (n.has("bend")) {
@@ -271,6 +288,7 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument(source + ": invalid YAML: " + e.what());
   }
+  check_yaml(root, source);
   const Node top(root, source, "");
   top.require_map({"description", "duration", "rate", "seed", "variation", "sensor", "camera", "object",
                    "holder", "occluders", "table", "estimator", "robot", "controller"});
@@ -278,9 +296,9 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
   s.path = source;
   s.name = fs::path(source).stem().string();
   const std::string base_dir = fs::path(source).parent_path().string();
-  if (top.has("duration")) s.duration = top.child("duration").positive();
-  if (top.has("rate")) s.rate = top.child("rate").positive();
-  if (top.has("seed")) s.seed = static_cast<unsigned>(top.child("seed").integer(0));
+  if (top.has("duration")) s.duration = top.child("duration").positive(kMaxDuration);
+  if (top.has("rate")) s.rate = top.child("rate").positive(kMaxRate);
+  if (top.has("seed")) s.seed = static_cast<unsigned>(top.child("seed").integer(0, std::numeric_limits<int>::max()));
   if (top.has("variation")) {
     const Node n = top.child("variation");
     n.require_map({"time", "position"});
@@ -294,14 +312,14 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
     n.require_map({"preset", "width", "height", "fx", "fy", "cx", "cy", "min_depth", "max_depth", "noise"});
     if (n.has("preset")) s.sensor.intrinsics = intrinsics_preset(n.child("preset").word({"d435-640", "fast-320"}));
     CameraIntrinsics& k = s.sensor.intrinsics;
-    if (n.has("width")) k.width = n.child("width").integer(8);
-    if (n.has("height")) k.height = n.child("height").integer(8);
-    if (n.has("fx")) k.fx = n.child("fx").positive();
-    if (n.has("fy")) k.fy = n.child("fy").positive();
-    if (n.has("cx")) k.cx = n.child("cx").number();
-    if (n.has("cy")) k.cy = n.child("cy").number();
-    if (n.has("min_depth")) s.sensor.min_depth = n.child("min_depth").positive();
-    if (n.has("max_depth")) s.sensor.max_depth = n.child("max_depth").positive();
+    if (n.has("width")) k.width = n.child("width").integer(8, kMaxImageSide);
+    if (n.has("height")) k.height = n.child("height").integer(8, kMaxImageSide);
+    if (n.has("fx")) k.fx = n.child("fx").positive(kMaxPixels);
+    if (n.has("fy")) k.fy = n.child("fy").positive(kMaxPixels);
+    if (n.has("cx")) k.cx = n.child("cx").in_range(-kMaxPixels, kMaxPixels);
+    if (n.has("cy")) k.cy = n.child("cy").in_range(-kMaxPixels, kMaxPixels);
+    if (n.has("min_depth")) s.sensor.min_depth = n.child("min_depth").positive(kMaxLength);
+    if (n.has("max_depth")) s.sensor.max_depth = n.child("max_depth").positive(kMaxLength);
     if (!(s.sensor.max_depth > s.sensor.min_depth)) n.child("max_depth").fail("must exceed min_depth");
     if (n.has("noise")) {
       const Node z = n.child("noise");
@@ -310,7 +328,7 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
       if (z.has("enabled")) m.enabled = z.child("enabled").boolean();
       if (z.has("depth_sigma")) m.depth_sigma = z.child("depth_sigma").in_range(0.0, 0.1);
       if (z.has("grazing_deg")) m.grazing_deg = z.child("grazing_deg").in_range(0.0, 90.0);
-      if (z.has("edge_jump")) m.edge_jump = z.child("edge_jump").positive();
+      if (z.has("edge_jump")) m.edge_jump = z.child("edge_jump").positive(kMaxLength);
       if (z.has("edge_dropout")) m.edge_dropout = z.child("edge_dropout").in_range(0.0, 1.0);
     }
   }
@@ -320,9 +338,9 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
   if (top.has("camera")) {
     const Node n = top.child("camera");
     n.require_map({"position", "look_at", "up"});
-    if (n.has("position")) position = n.child("position").vector(3);
-    if (n.has("look_at")) look_at = n.child("look_at").vector(3);
-    if (n.has("up")) up = n.child("up").vector(3);
+    if (n.has("position")) position = n.child("position").vector(3, kMaxLength);
+    if (n.has("look_at")) look_at = n.child("look_at").vector(3, kMaxLength);
+    if (n.has("up")) up = n.child("up").vector(3, kMaxLength);
   }
   const Eigen::Vector3d z = look_at - position;
   if (z.norm() < 1e-6) top.child("camera").fail("look_at must differ from position");
@@ -351,13 +369,13 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
     table.name = "table";
     table.role = Role::Background;
     table.shape = "box";
-    if (t.has("size")) size = t.child("size").vector(3);
+    if (t.has("size")) size = t.child("size").vector(3, kMaxLength);
     if (!(size.array() > 0.0).all()) t.child("size").fail("expected positive sizes");
     table.mesh = make_box(size);
     table.colour = {0.55f, 0.42f, 0.3f};
     if (t.has("colour")) table.colour = colour(t.child("colour"));
     Waypoint w;
-    w.position = t.has("position") ? Eigen::Vector3d(t.child("position").vector(3)) : Eigen::Vector3d(0, 0.12, 0.6);
+    w.position = t.has("position") ? Eigen::Vector3d(t.child("position").vector(3, kMaxLength)) : Eigen::Vector3d(0, 0.12, 0.6);
     table.motion.waypoints.push_back(w);
     s.bodies.push_back(table);
   }
@@ -384,8 +402,9 @@ Scenario scenario_from_yaml(const std::string& text, const std::string& source) 
     const Node c = top.child("controller");
     c.require_map({"law", "gain", "max_linear_speed", "max_angular_speed", "target_filter"});
     if (c.has("law")) s.controller["law"] = c.child("law").word({"pbvs", "sphere"});
-    for (const char* k : {"gain", "max_linear_speed", "max_angular_speed"}) {
-      if (c.has(k)) s.controller[k] = std::to_string(c.child(k).positive());
+    if (c.has("gain")) s.controller["gain"] = std::to_string(c.child("gain").positive(kMaxGain));
+    for (const char* k : {"max_linear_speed", "max_angular_speed"}) {
+      if (c.has(k)) s.controller[k] = std::to_string(c.child(k).positive(kMaxSpeed));
     }
     if (c.has("target_filter")) s.controller["target_filter"] = std::to_string(c.child("target_filter").in_range(0.0, 10.0));
   }
@@ -495,6 +514,10 @@ Scenario load_scenario(const std::string& path_or_name) {
   }
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path.string() + ": cannot read file");
+  std::error_code ec;
+  if (fs::file_size(path, ec) > kMaxFileBytes && !ec) {
+    throw std::invalid_argument(path.string() + ": larger than " + std::to_string(kMaxFileBytes) + " bytes");
+  }
   std::stringstream text;
   text << in.rdbuf();
   return scenario_from_yaml(text.str(), path.string());

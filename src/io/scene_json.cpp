@@ -5,12 +5,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <stdexcept>
+#include <vector>
 
 namespace ofv {
 namespace {
@@ -30,13 +34,26 @@ struct Where {
   }
 };
 
-std::string shown(const json& j) {
-  std::string text = j.dump();
+// Text from the document, cut short: error messages never print a document.
+std::string clip(std::string text) {
   constexpr std::size_t kMax = 60;
   if (text.size() > kMax) {
     text = text.substr(0, kMax) + "...";
   }
   return text;
+}
+
+std::string shown(const json& j) {
+  const bool flat = j.size() <= 8 && std::none_of(j.begin(), j.end(), [](const json& item) {
+                      return item.is_structured();
+                    });
+  if (j.is_array() && !flat) {
+    return "an array of " + std::to_string(j.size()) + " items";
+  }
+  if (j.is_object() && !flat) {
+    return "an object of " + std::to_string(j.size()) + " keys";
+  }
+  return clip(j.dump());  // a value or a short flat array
 }
 
 [[noreturn]] void fail(const Where& at, const std::string& what) {
@@ -73,7 +90,7 @@ void check_keys(const json& j, const Where& at, std::initializer_list<const char
       for (const char* key : allowed) {
         list += list.empty() ? key : std::string(", ") + key;
       }
-      fail(at[item.key()], "unknown key (expected one of: " + list + ")");
+      fail(at[clip(item.key())], "unknown key (expected one of: " + list + ")");
     }
   }
 }
@@ -216,15 +233,42 @@ Scene scene_from_json(const json& j, const std::string& source) {
 }
 
 Scene read_scene(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw std::invalid_argument(path + ": cannot read file (" + std::strerror(errno) + ")");
   }
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxSceneBytes) {
+    throw std::invalid_argument(path + ": " + std::to_string(bytes) + " bytes, more than " +
+                                std::to_string(kMaxSceneBytes));
+  }
+  // The parser's callback sees every value as it is read: nesting deeper than
+  // kMaxSceneDepth and a key repeated in one object stop the parse there.
+  std::vector<std::set<std::string>> keys;  // of the objects being read
+  std::string problem;
+  const json::parser_callback_t check = [&](int depth, json::parse_event_t event, json& parsed) {
+    if (depth > kMaxSceneDepth) {
+      problem = "nested deeper than " + std::to_string(kMaxSceneDepth) + " levels";
+      throw std::invalid_argument(problem);
+    }
+    if (event == json::parse_event_t::object_start) {
+      keys.emplace_back();
+    } else if (event == json::parse_event_t::object_end) {
+      keys.pop_back();
+    } else if (event == json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second) {
+      problem = "duplicate key \"" + clip(parsed.get<std::string>()) + "\"";
+      throw std::invalid_argument(problem);
+    }
+    return true;
+  };
   json j;
   try {
-    j = json::parse(in);
+    j = json::parse(in, check);
   } catch (const json::exception& e) {  // syntax errors and number overflow (1e999)
-    throw std::invalid_argument(path + ": invalid JSON: " + e.what());
+    throw std::invalid_argument(path + ": invalid JSON: " + clip(e.what()));
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument(path + ": invalid JSON: " + problem);
   }
   return scene_from_json(j, path);
 }

@@ -1,8 +1,4 @@
-// .oni writer: the OpenNI2 record format (file format 1.0.1.0), uncompressed
-// frames. Layout (little-endian, packed), as OpenNI2's recorder writes it:
-//   file header: "NI10", version {1,0,1,0}, u64 max timestamp, u32 max node id
-//   record: u32 magic "NIR\0", u32 type, u32 node id, u32 fields size
-//           (header included), u32 payload size, u64 undo position; fields; payload
+// .oni writer: the OpenNI2 record format (oni_format.h), uncompressed frames.
 // Per node: NODE_ADDED and its properties (video mode, pixel format, field of
 // view, cropping - the player drops frames of a node without cropping); then
 // per node NODE_STATE_READY and NODE_DATA_BEGIN; then NEW_DATA records; END
@@ -10,6 +6,7 @@
 #include "ofv/sources/openni2_source.h"
 
 #include "ofv/perception/cloud.h"
+#include "oni_format.h"
 
 #include <OniCEnums.h>
 
@@ -22,29 +19,16 @@ namespace ofv {
 
 namespace {
 
-enum RecordType : std::uint32_t {
-  kIntProperty = 0x03,
-  kGeneralProperty = 0x06,
-  kNodeDataBegin = 0x08,
-  kNodeStateReady = 0x09,
-  kNewData = 0x0A,
-  kEnd = 0x0B,
-  kNodeAdded = 0x0D,
-};
-constexpr std::uint32_t kNodeTypeDepth = 2;
-constexpr std::uint32_t kNodeTypeImage = 3;
-constexpr std::uint32_t kCodecUncompressed =
-    'N' | ('O' << 8) | ('N' << 16) | (std::uint32_t{'E'} << 24);
+using namespace oni;
 constexpr std::uint32_t kXnPixelFormatRgb24 = 1;
 constexpr std::uint32_t kXnPixelFormatGray16 = 4;
-constexpr std::size_t kRecordHeaderBytes = 28;
 
 /// One record being assembled: header, fields, payload.
 class Record {
  public:
   Record(std::uint32_t type, std::uint32_t node, std::uint64_t undo)
       : bytes_(kRecordHeaderBytes, 0) {
-    put_at(0, std::uint32_t{0x0052494E});  // "NIR\0"
+    put_at(0, kRecordMagic);
     put_at(4, type);
     put_at(8, node);
     put_at(20, undo);

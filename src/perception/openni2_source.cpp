@@ -3,6 +3,7 @@
 
 #include <OpenNI.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -93,6 +94,9 @@ void OpenNi2Source::rewind() {
   if (looks_like_file(uri_) && !fs::is_regular_file(uri_)) {
     throw std::runtime_error(uri_ + ": no such .oni file");
   }
+  if (looks_like_file(uri_)) {
+    check_oni_file(uri_);  // OpenNI2 never sees a malformed record
+  }
   initialise_openni();
   auto impl = std::make_unique<Impl>();
   if (impl->device.open(uri_.empty() ? openni::ANY_DEVICE : uri_.c_str()) != openni::STATUS_OK) {
@@ -116,6 +120,10 @@ void OpenNi2Source::rewind() {
     const std::string poses = uri_ + ".poses.txt";
     if (fs::exists(poses)) {
       impl->poses = read_pose_file(poses);
+      if (impl->poses.size() < static_cast<std::size_t>(impl->frames)) {
+        throw std::invalid_argument(poses + ": " + std::to_string(impl->poses.size()) + " poses for " +
+                                    std::to_string(impl->frames) + " frames");
+      }
     }
   } else {
     if (options_.registration && impl->has_colour &&
@@ -250,7 +258,7 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
   if (!s.poses.empty()) {
     // Frame i of a recording made by OniWriter has pose line i.
     const auto i = static_cast<std::size_t>(s.read - 1);
-    f.wMc = i < s.poses.size() ? s.poses[i].wMc : s.poses.back().wMc;
+    f.wMc = s.poses[std::min(i, s.poses.size() - 1)].wMc;  // as many poses as frames (rewind)
   }
   return f;
 }

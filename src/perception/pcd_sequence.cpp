@@ -3,6 +3,7 @@
 
 #include "ofv/perception/cloud.h"
 
+#include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -15,6 +16,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -22,6 +25,123 @@ namespace fs = std::filesystem;
 namespace ofv {
 
 namespace {
+
+/**
+ * Checks what PCL would trust in a PCD header (PCL maps binary data without
+ * checking it against the file size, and crashes on empty or garbage files):
+ * every header line present, the per-field lists consistent, x, y, z as
+ * 4-byte floats and a 4-byte rgb or rgba, POINTS = WIDTH * HEIGHT <=
+ * kMaxPcdPoints, and for binary data the points inside the file.
+ */
+void check_pcd_header(const std::string& path) {
+  const auto fail = [&](const std::string& what) {
+    throw std::invalid_argument(path + ": invalid PCD header: " + what);
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw std::invalid_argument(path + ": cannot open the PCD file");
+  }
+  std::map<std::string, std::vector<std::string>> header;
+  std::string line;
+  while (header.count("DATA") == 0 && std::getline(in, line) && in.tellg() < 65536) {
+    std::istringstream words(line);
+    std::string key, word;
+    if (!(words >> key) || key[0] == '#') {
+      continue;
+    }
+    if (header.count(key) != 0) {
+      fail("duplicate " + key);
+    }
+    auto& values = header[key];
+    while (words >> word) {
+      values.push_back(word);
+    }
+  }
+  for (const char* key : {"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "POINTS", "DATA"}) {
+    if (header.count(key) == 0) {
+      fail(std::string("no ") + key + " line");
+    }
+  }
+  const auto& fields = header["FIELDS"];
+  for (const char* key : {"SIZE", "TYPE", "COUNT"}) {
+    if (fields.empty() || header[key].size() != fields.size()) {
+      fail(std::string(key) + " has " + std::to_string(header[key].size()) + " values for " +
+           std::to_string(fields.size()) + " FIELDS");
+    }
+  }
+  const auto count = [&](const char* key, const std::string& text) {
+    std::size_t used = 0;
+    unsigned long long v = 0;
+    try {
+      v = std::stoull(text, &used);
+    } catch (const std::exception&) {
+    }
+    if (used == 0 || used != text.size() || text[0] == '-') {
+      fail(std::string(key) + " " + text.substr(0, 20) + ": expected a count");
+    }
+    return v;
+  };
+  std::uint64_t point_bytes = 0;
+  std::map<std::string, std::string> kinds;  // field -> TYPE SIZE COUNT, e.g. "F41"
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::string& size = header["SIZE"][i];
+    const std::string& type = header["TYPE"][i];
+    if (size != "1" && size != "2" && size != "4" && size != "8") {
+      fail("SIZE of " + fields[i] + " " + size.substr(0, 20) + ": expected 1, 2, 4 or 8");
+    }
+    if (type != "F" && type != "I" && type != "U") {
+      fail("TYPE of " + fields[i] + " " + type.substr(0, 20) + ": expected F, I or U");
+    }
+    const std::uint64_t n = count("COUNT", header["COUNT"][i]);
+    if (n == 0 || n > 1024) {
+      fail("COUNT of " + fields[i] + " " + std::to_string(n) + ": expected 1 to 1024");
+    }
+    point_bytes += std::stoull(size) * n;
+    kinds[fields[i]] = type + size + (n == 1 ? "1" : "n");
+  }
+  const auto kind = [&](const char* f) { return kinds.count(f) != 0 ? kinds[f] : std::string("---"); };
+  for (const char* f : {"x", "y", "z"}) {
+    if (kind(f) != "F41") {
+      fail(std::string("field ") + f + ": expected a 4-byte float (FIELDS x y z rgb|rgba)");
+    }
+  }
+  if (kind("rgb").substr(1) != "41" && kind("rgba").substr(1) != "41") {
+    fail("no 4-byte rgb or rgba field");
+  }
+  if (header["WIDTH"].size() != 1 || header["HEIGHT"].size() != 1 || header["POINTS"].size() != 1) {
+    fail("WIDTH, HEIGHT and POINTS take one value each");
+  }
+  const std::uint64_t width = count("WIDTH", header["WIDTH"][0]);
+  const std::uint64_t height = count("HEIGHT", header["HEIGHT"][0]);
+  const std::uint64_t points = count("POINTS", header["POINTS"][0]);
+  if (width == 0 || height == 0 || width > kMaxPcdPoints || height > kMaxPcdPoints ||
+      points != width * height) {
+    fail("POINTS " + std::to_string(points) + " for WIDTH " + std::to_string(width) +
+         " x HEIGHT " + std::to_string(height));
+  }
+  if (points > kMaxPcdPoints) {
+    fail("POINTS " + std::to_string(points) + ": more than " + std::to_string(kMaxPcdPoints));
+  }
+  const std::string data = header["DATA"].empty() ? "" : header["DATA"][0];
+  const std::uint64_t file_size = std::filesystem::file_size(path);
+  const std::uint64_t start = in ? static_cast<std::uint64_t>(in.tellg()) : file_size;
+  if (data == "binary") {
+    if (start + points * point_bytes > file_size) {
+      fail("DATA binary: " + std::to_string(points) + " points of " + std::to_string(point_bytes) +
+           " bytes need " + std::to_string(points * point_bytes) + " bytes, the file has " +
+           std::to_string(file_size - start) + " after the header");
+    }
+  } else if (data == "binary_compressed") {
+    std::uint32_t sizes[2] = {0, 0};  // compressed, uncompressed
+    in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
+    if (!in || start + 8 + sizes[0] > file_size || sizes[1] != points * point_bytes) {
+      fail("DATA binary_compressed: the sizes " + std::to_string(sizes[0]) + " and " +
+           std::to_string(sizes[1]) + " do not fit the points and the file");
+    }
+  } else if (data != "ascii") {
+    fail("DATA " + data.substr(0, 20) + ": expected ascii, binary or binary_compressed");
+  }
+}
 
 /// Least-squares fit of x/z = (u - cx)/fx and y/z = (v - cy)/fy over the valid points.
 std::optional<CameraIntrinsics> fit_intrinsics(const pcl::PointCloud<pcl::PointXYZRGBA>& cloud) {
@@ -63,6 +183,8 @@ std::optional<CameraIntrinsics> fit_intrinsics(const pcl::PointCloud<pcl::PointX
 }  // namespace
 
 PcdSequenceSource::PcdSequenceSource(const std::string& directory) : directory_(directory) {
+  // PCL reports on the terminal; ofv's errors name the file instead.
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   if (!fs::is_directory(directory)) {
     throw std::runtime_error(directory + ": not a directory (expected a PCD sequence)");
   }
@@ -98,26 +220,33 @@ std::optional<RgbdFrame> PcdSequenceSource::next() {
   const std::string& path = files_[next_];
   const StampedPose& pose = poses_[next_];
   ++next_;
+  check_pcd_header(path);
   pcl::PointCloud<pcl::PointXYZRGBA> cloud;
   pcl::PCDReader reader;
-  if (reader.read(path, cloud) != 0) {
-    throw std::runtime_error(path + ": cannot read the PCD file");
+  int status = 0;
+  try {
+    status = reader.read(path, cloud);
+  } catch (const std::exception& e) {  // PCL throws on data its header check let through
+    throw std::invalid_argument(path + ": cannot read the PCD file: " + e.what());
+  }
+  if (status != 0) {
+    throw std::invalid_argument(path + ": cannot read the PCD file");
   }
   if (!cloud.isOrganized()) {
-    throw std::runtime_error(path +
-                             ": the cloud is not organised (height 1); an RGB-D frame needs rows");
+    throw std::invalid_argument(path +
+                                ": the cloud is not organised (height 1); an RGB-D frame needs rows");
   }
   if (!intrinsics_) {
     intrinsics_ = fit_intrinsics(cloud);
     if (!intrinsics_) {
-      throw std::runtime_error(path + ": cannot fit intrinsics to the points; add intrinsics.txt");
+      throw std::invalid_argument(path + ": cannot fit intrinsics to the points; add intrinsics.txt");
     }
   }
   RgbdFrame f;
   f.intrinsics = *intrinsics_;
   if (static_cast<int>(cloud.width) != f.intrinsics.width ||
       static_cast<int>(cloud.height) != f.intrinsics.height) {
-    throw std::runtime_error(path + ": " + std::to_string(cloud.width) + "x" +
+    throw std::invalid_argument(path + ": " + std::to_string(cloud.width) + "x" +
                              std::to_string(cloud.height) + " points, the intrinsics say " +
                              std::to_string(f.intrinsics.width) + "x" +
                              std::to_string(f.intrinsics.height));

@@ -37,9 +37,14 @@ std::vector<StampedPose> read_pose_file(const std::string& path) {
                                ": expected 't tx ty tz qx qy qz qw', got '" + line + "'");
     }
     const Eigen::Quaterniond q(qw, qx, qy, qz);
-    if (!(q.norm() > 1e-6) || !std::isfinite(q.norm()) || !std::isfinite(tx + ty + tz + t)) {
+    if (!std::isfinite(tx + ty + tz + t)) {
       throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose '" + line +
                                "'");
+    }
+    if (!(std::abs(q.norm() - 1.0) <= kQuaternionTolerance)) {
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": quaternion norm " +
+                               std::to_string(q.norm()) + ", expected 1 +- " +
+                               std::to_string(kQuaternionTolerance));
     }
     StampedPose p;
     p.time = t;
@@ -94,8 +99,10 @@ CameraIntrinsics read_intrinsics_file(const std::string& path) {
     std::istringstream fields(line);
     CameraIntrinsics k;
     if (!(fields >> k.width >> k.height >> k.fx >> k.fy >> k.cx >> k.cy) || k.width <= 0 ||
-        k.height <= 0 || !(k.fx > 0.0) || !(k.fy > 0.0)) {
-      throw std::runtime_error(path + ": expected 'width height fx fy cx cy', got '" + line + "'");
+        k.height <= 0 || k.width > kMaxImageSide || k.height > kMaxImageSide || !std::isfinite(k.cx) || !std::isfinite(k.cy) ||
+        !std::isfinite(k.fx) || !std::isfinite(k.fy) || !(k.fx > 0.0) || !(k.fy > 0.0)) {
+      throw std::runtime_error(path + ": expected 'width height fx fy cx cy' (sizes 1 to " +
+                               std::to_string(kMaxImageSide) + ", focal lengths > 0), got '" + line + "'");
     }
     found = k;
   });

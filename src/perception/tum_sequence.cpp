@@ -1,4 +1,5 @@
-// TUM RGB-D layout: reader and writer (PNG I/O with OpenCV).
+// TUM RGB-D layout: reader (PNG through libpng's simplified API, which reports
+// errors in its result rather than on the terminal) and writer (OpenCV).
 #include "ofv/sources/tum_sequence.h"
 
 #include "ofv/perception/cloud.h"
@@ -7,11 +8,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <png.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -43,6 +47,56 @@ std::vector<ListEntry> read_list(const std::string& path) {
   return out;
 }
 
+/// A PNG file whose header has been read and checked, ready to decode.
+class Png {
+ public:
+  Png(const std::string& path, const char* what) : path_(path), what_(what) {
+    image_.version = PNG_IMAGE_VERSION;
+    // Reads the chunks before the pixel data only: the size is checked before any decoding.
+    if (png_image_begin_read_from_file(&image_, path.c_str()) == 0) {
+      fail("not a readable PNG (" + std::string(image_.message) + ")");
+    }
+    if (image_.width > kMaxImageSide || image_.height > kMaxImageSide) {
+      fail(std::to_string(image_.width) + "x" + std::to_string(image_.height) +
+           " pixels, more than " + std::to_string(kMaxImageSide) + " a side");
+    }
+  }
+  ~Png() { png_image_free(&image_); }
+  Png(const Png&) = delete;
+  Png& operator=(const Png&) = delete;
+
+  [[nodiscard]] int width() const { return static_cast<int>(image_.width); }
+  [[nodiscard]] int height() const { return static_cast<int>(image_.height); }
+  /// The file's format in words, e.g. "16-bit RGB".
+  [[nodiscard]] std::string format() const {
+    const png_uint_32 f = image_.format;
+    return std::string((f & PNG_FORMAT_FLAG_LINEAR) != 0 ? "16-bit " : "8-bit ") +
+           ((f & PNG_FORMAT_FLAG_COLORMAP) != 0 ? "palette " : "") +
+           ((f & PNG_FORMAT_FLAG_COLOR) != 0 ? "RGB" : "grey") +
+           ((f & PNG_FORMAT_FLAG_ALPHA) != 0 ? "A" : "");
+  }
+  [[nodiscard]] bool is_grey16() const { return image_.format == PNG_FORMAT_LINEAR_Y; }
+
+  /// Decodes to `format` (PNG_FORMAT_LINEAR_Y: 16-bit values as stored; PNG_FORMAT_RGB).
+  template <typename T>
+  std::vector<T> decode(png_uint_32 format) {
+    image_.format = format;
+    std::vector<T> pixels(PNG_IMAGE_SIZE(image_) / sizeof(T));
+    if (png_image_finish_read(&image_, nullptr, pixels.data(), 0, nullptr) == 0) {
+      fail("corrupt PNG (" + std::string(image_.message) + ")");
+    }
+    return pixels;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const {
+    throw std::invalid_argument(path_ + ": " + what_ + ": " + why);
+  }
+  std::string path_;
+  const char* what_;
+  png_image image_{};
+};
+
 }  // namespace
 
 TumSequenceSource::TumSequenceSource(const std::string& directory,
@@ -72,8 +126,24 @@ TumSequenceSource::TumSequenceSource(const std::string& directory,
     }
     entries_.push_back(e);
   }
-  if (fs::exists(dir / "groundtruth.txt")) {
-    poses_ = read_pose_file((dir / "groundtruth.txt").string());
+  const std::string ground_truth = (dir / "groundtruth.txt").string();
+  if (!fs::exists(ground_truth)) {
+    throw std::invalid_argument(ground_truth + ": missing (the camera pose of each depth image)");
+  }
+  poses_ = read_pose_file(ground_truth);
+  for (const Entry& e : entries_) {
+    const auto after = std::lower_bound(poses_.begin(), poses_.end(), e.time,
+                                        [](const StampedPose& p, double t) { return p.time < t; });
+    double gap = std::numeric_limits<double>::infinity();
+    if (after != poses_.end()) gap = after->time - e.time;
+    if (after != poses_.begin()) gap = std::min(gap, e.time - (after - 1)->time);
+    if (!(gap <= options.max_pose_time_difference)) {
+      char stamp[64];
+      std::snprintf(stamp, sizeof stamp, "%.6f", e.time);
+      throw std::invalid_argument(ground_truth + ": no pose within " +
+                                  std::to_string(options.max_pose_time_difference) +
+                                  " s of the depth image at timestamp " + stamp);
+    }
   }
   if (options.intrinsics) {
     intrinsics_ = *options.intrinsics;
@@ -93,41 +163,32 @@ std::optional<RgbdFrame> TumSequenceSource::next() {
   RgbdFrame f;
   f.timestamp = e.time - entries_.front().time;
   f.intrinsics = intrinsics_;
-  f.wMc = poses_.empty() ? Eigen::Isometry3d::Identity() : interpolate_pose(poses_, e.time);
+  f.wMc = interpolate_pose(poses_, e.time);
 
   const std::string depth_path = (dir / e.depth).string();
-  const cv::Mat depth = cv::imread(depth_path, cv::IMREAD_ANYDEPTH);
-  if (depth.empty()) {
-    throw std::runtime_error(depth_path + ": cannot read the depth image");
+  Png depth(depth_path, "depth image");
+  if (!depth.is_grey16()) {
+    throw std::invalid_argument(depth_path + ": depth image: expected a 16-bit grey PNG, found " +
+                                depth.format());
   }
-  if (depth.type() != CV_16UC1) {
-    throw std::runtime_error(depth_path + ": expected a 16-bit single-channel PNG");
+  if (depth.width() != intrinsics_.width || depth.height() != intrinsics_.height) {
+    throw std::invalid_argument(depth_path + ": " + std::to_string(depth.width()) + "x" +
+                                std::to_string(depth.height()) + " pixels, the intrinsics say " +
+                                std::to_string(intrinsics_.width) + "x" +
+                                std::to_string(intrinsics_.height));
   }
-  if (depth.cols != intrinsics_.width || depth.rows != intrinsics_.height) {
-    throw std::runtime_error(depth_path + ": " + std::to_string(depth.cols) + "x" +
-                             std::to_string(depth.rows) + " pixels, the intrinsics say " +
-                             std::to_string(intrinsics_.width) + "x" +
-                             std::to_string(intrinsics_.height));
-  }
-  f.depth.resize(static_cast<std::size_t>(depth.total()));
-  for (int v = 0; v < depth.rows; ++v) {
-    const auto* row = depth.ptr<std::uint16_t>(v);
-    for (int u = 0; u < depth.cols; ++u) {
-      f.depth[f.index(u, v)] = depth_from_units(row[u], options_.depth_factor);
-    }
+  const std::vector<png_uint_16> units = depth.decode<png_uint_16>(PNG_FORMAT_LINEAR_Y);
+  f.depth.resize(units.size());
+  for (std::size_t i = 0; i < units.size(); ++i) {
+    f.depth[i] = depth_from_units(units[i], options_.depth_factor);
   }
   if (!e.rgb.empty()) {
     const std::string rgb_path = (dir / e.rgb).string();
-    const cv::Mat bgr = cv::imread(rgb_path, cv::IMREAD_COLOR);
-    if (bgr.empty()) {
-      throw std::runtime_error(rgb_path + ": cannot read the colour image");
+    Png rgb(rgb_path, "colour image");
+    if (rgb.width() != depth.width() || rgb.height() != depth.height()) {
+      throw std::invalid_argument(rgb_path + ": colour and depth sizes differ");
     }
-    if (bgr.cols != depth.cols || bgr.rows != depth.rows) {
-      throw std::runtime_error(rgb_path + ": colour and depth sizes differ");
-    }
-    cv::Mat rgb;
-    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-    f.rgb.assign(rgb.data, rgb.data + rgb.total() * 3);
+    f.rgb = rgb.decode<std::uint8_t>(PNG_FORMAT_RGB);
   }
   return f;
 }

@@ -116,7 +116,7 @@ TEST(OpenNi2, MissingOrBrokenFilesAreErrorsNamingThePath) {
   try {
     OpenNi2Source source(broken);
     FAIL() << "expected an error";
-  } catch (const std::runtime_error& e) {
+  } catch (const std::invalid_argument& e) {  // check_oni_file: bad input
     EXPECT_NE(std::string(e.what()).find(broken), std::string::npos);
   }
   try {

@@ -131,6 +131,10 @@ TEST(TumSequence, BrokenInputsAreErrorsNamingThePath) {
   std::ofstream(dir / "groundtruth.txt") << "0.0 1 2 3\n";
   EXPECT_NE(message([&] { TumSequenceSource s(dir.string()); }).find("groundtruth.txt:1"),
             std::string::npos);
+  // A quaternion of norm 2 is not a rotation (within kQuaternionTolerance).
+  std::ofstream(dir / "groundtruth.txt") << "0.0 1 2 3 0 0 0 2\n";
+  const std::string norm = message([&] { TumSequenceSource s(dir.string()); });
+  EXPECT_NE(norm.find("groundtruth.txt:1: quaternion norm 2"), std::string::npos) << norm;
 }
 
 TEST(PcdSequence, WritesAndReadsBackFramesAndFitsIntrinsics) {

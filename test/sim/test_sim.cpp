@@ -76,6 +76,36 @@ TEST(Scenario, ErrorsNameFileKeyAndValue) {
   }
 }
 
+TEST(Scenario, RepeatedKeysDeepNestingAndAliasBombsAreErrors) {
+  // yaml-cpp keeps the first of two equal keys: the check names the second.
+  EXPECT_NE(error_of("object: {shape: box}\nrate: 10\nrate: 30").find("test.yaml:3: duplicate key 'rate'"),
+            std::string::npos);
+  EXPECT_NE(error_of("object:\n  shape: box\n  shape: sphere").find("test.yaml:3: duplicate key 'shape'"),
+            std::string::npos);
+  EXPECT_NE(error_of("object: {shape: box}\ndescription: " + std::string(40, '[') + std::string(40, ']'))
+                .find("nested deeper than 32"),
+            std::string::npos);
+  // Each alias is walked where it is used: nine levels of ten make 10^9 nodes.
+  std::string bomb = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int k = 1; k < 9; ++k) {
+    const std::string p = "*a" + std::to_string(k - 1);
+    bomb += "a" + std::to_string(k) + ": &a" + std::to_string(k) + " [" + p + ", " + p + ", " + p + ", " + p +
+            ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + "]\n";
+  }
+  EXPECT_NE(error_of(bomb).find("more than 100000 nodes"), std::string::npos) << error_of(bomb);
+}
+
+TEST(Scenario, EveryNumberHasAnUpperBound) {
+  for (const char* yaml :
+       {"object: {shape: cloth, grid: [100000, 100000]}", "object: {shape: box}\nduration: 1e9",
+        "object: {shape: box}\nrate: 1e9", "object: {shape: box}\nsensor: {width: 40000}",
+        "object: {shape: box}\nsensor: {fx: 1e300}", "object: {shape: sphere, radius: 1e6}",
+        "object: {shape: box, position: [0, 0, 1e9]}", "object: {shape: box}\ncontroller: {gain: 1e9}",
+        "object: {shape: box}\ntable: {size: [1e9, 1, 1]}"}) {
+    EXPECT_NE(error_of(yaml).find("expected"), std::string::npos) << yaml << " -> " << error_of(yaml);
+  }
+}
+
 TEST(Scenario, BuiltInScenariosLoad) {
   const auto names = builtin_scenarios();
   for (const char* expected : {"dvd-static", "dvd-one-hand", "dvd-two-hands", "cloth-occluder",

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -28,8 +29,16 @@ struct Scene {
 /// \throws std::invalid_argument on unknown keys, wrong types, bad values.
 [[nodiscard]] Scene scene_from_json(const nlohmann::json& j, const std::string& source);
 
+/// \brief Largest scene file [bytes] read_scene() reads (64 MiB).
+constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{64} << 20;
+/// \brief Deepest nesting of arrays and objects read_scene() reads (a scene needs 4).
+constexpr int kMaxSceneDepth = 32;
+
 /// \brief Reads and parses a scene file.
-/// \throws std::invalid_argument if the file cannot be read or parsed.
+/// \throws std::invalid_argument if the file cannot be read, is larger than
+/// kMaxSceneBytes, is not JSON, nests deeper than kMaxSceneDepth or repeats a key
+/// in one object; the message names the file and never quotes more than a few
+/// characters of it.
 [[nodiscard]] Scene read_scene(const std::string& path);
 
 /// \brief Writes a scene as JSON (only the parameters that were given).

@@ -37,6 +37,24 @@ struct OpenNi2Options {
 };
 
 /**
+ * \brief Checks the structure of a `.oni` file (OpenNI2 file format 1.0.1.0)
+ *        before OpenNI2's player, which trusts it, reads it.
+ *
+ * The file header (magic NI10, version 1.0.1.0, at most 16 nodes) and every
+ * record up to END: magic, known type, node id added and within the header's
+ * maximum, fields that exactly fill the record (names of at most 80 bytes,
+ * 8-byte integer and real properties), payloads of at most 1600 x 1200 x 3
+ * bytes inside the file (uncompressed frames exactly width x height x bytes
+ * per pixel of the node's mode), undo positions at earlier records, frame
+ * numbers 1, 2, ... per node and as many as NODE_ADDED claims, a seek table
+ * (OpenNI2's recorder writes one) pointing at frames of its node; the video
+ * mode at most 4096 x 4096, the field of view in (0, pi). Compressed payloads
+ * (16zT, JPEG) are left to OpenNI2's decoders.
+ * \throws std::invalid_argument "PATH: offset N: what" at the first problem.
+ */
+void check_oni_file(const std::string& path);
+
+/**
  * \brief Frames from an OpenNI2 device (URI, e.g. a PrimeSense device URI,
  *        `Dummy`) or a `.oni` file.
  *
@@ -49,7 +67,9 @@ class OpenNi2Source : public FrameSource {
  public:
   /// An empty URI opens the first device OpenNI2 finds.
   /// \throws std::runtime_error naming the URI or path when OpenNI2 cannot
-  /// initialise, the device or file cannot be opened, or it has no depth stream.
+  /// initialise, the device or file cannot be opened, or it has no depth stream;
+  /// std::invalid_argument when a file fails check_oni_file() or its poses file
+  /// has fewer poses than the recording has frames.
   explicit OpenNi2Source(const std::string& uri, const OpenNi2Options& options = {});
   ~OpenNi2Source() override;
   OpenNi2Source(const OpenNi2Source&) = delete;

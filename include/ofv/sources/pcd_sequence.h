@@ -8,17 +8,26 @@
  * `poses.txt`: one TUM pose line `t tx ty tz qx qy qz qw` (wMc) per PCD
  * file, in the same order. Optional `intrinsics.txt` (`width height fx fy cx
  * cy`); without it the intrinsics are fitted to the organised points.
+ *
+ * Each file's header is checked before PCL reads it: VERSION, FIELDS, SIZE,
+ * TYPE, COUNT, WIDTH, HEIGHT, POINTS and DATA present, x y z 4-byte floats
+ * and a 4-byte rgb or rgba field, POINTS = WIDTH x HEIGHT <= kMaxPcdPoints,
+ * binary data inside the file.
  */
 #pragma once
 
 #include "ofv/frame_source.h"
 #include "ofv/sources/sequence_files.h"
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace ofv {
+
+/// \brief Largest number of points of one PCD frame (kMaxImageSide squared).
+constexpr std::uint64_t kMaxPcdPoints = std::uint64_t{kMaxImageSide} * kMaxImageSide;
 
 /// \brief Reads a PCD sequence frame by frame (see the file comment for the layout).
 class PcdSequenceSource : public FrameSource {
@@ -27,8 +36,8 @@ class PcdSequenceSource : public FrameSource {
   /// files or poses.txt are missing, or the counts differ.
   explicit PcdSequenceSource(const std::string& directory);
 
-  /// \throws std::runtime_error naming the file when a PCD cannot be read, is not
-  /// organised, or its intrinsics cannot be fitted.
+  /// \throws std::invalid_argument naming the file when a PCD's header is
+  /// malformed, it cannot be read, is not organised, or its intrinsics cannot be fitted.
   std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::string describe() const override;
   [[nodiscard]] std::size_t size() const { return files_.size(); }

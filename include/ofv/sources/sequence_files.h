@@ -16,6 +16,9 @@
 
 namespace ofv {
 
+/// \brief Largest image side [px] of a recorded sequence (images, intrinsics, PCD rows).
+constexpr int kMaxImageSide = 4096;
+
 /**
  * rief Calls `f(line, number)` for each data line of a sequence text file:
  *        blank lines and `#` comments are skipped; numbers count from 1.
@@ -31,8 +34,13 @@ struct StampedPose {
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
 };
 
+/// \brief Largest difference from 1 of a pose file's quaternion norm (files
+/// written with 4 decimals are within 2e-4); the quaternion is then normalised.
+constexpr double kQuaternionTolerance = 1e-3;
+
 /**
- * \brief Reads a TUM pose file: `t tx ty tz qx qy qz qw` per line, `#` comments.
+ * \brief Reads a TUM pose file: `t tx ty tz qx qy qz qw` per line, `#` comments;
+ *        the quaternion of unit norm within kQuaternionTolerance.
  * \throws std::runtime_error naming the file and line when it cannot be read or parsed.
  */
 [[nodiscard]] std::vector<StampedPose> read_pose_file(const std::string& path);
@@ -49,7 +57,8 @@ struct StampedPose {
                                                  double time);
 
 /**
- * \brief Reads `width height fx fy cx cy` (one line, `#` comments) [px].
+ * \brief Reads `width height fx fy cx cy` (one line, `#` comments) [px]; width and
+ *        height at most kMaxImageSide.
  * \throws std::runtime_error naming the file when it cannot be read or parsed.
  */
 [[nodiscard]] CameraIntrinsics read_intrinsics_file(const std::string& path);

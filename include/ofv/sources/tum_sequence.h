@@ -5,10 +5,12 @@
  *
  * A directory holding `rgb/` (8-bit colour PNGs), `depth/` (16-bit PNGs,
  * depth = value / 5000 m, 0 = missing), `rgb.txt` and `depth.txt`
- * (`timestamp filename` per line) and, optionally, `groundtruth.txt` (camera
- * poses `t tx ty tz qx qy qz qw`, camera -> world, optical axes X right,
- * Y down, Z forward) and `intrinsics.txt` (`width height fx fy cx cy`, an ofv
- * addition; without it the TUM default 525, 525, 319.5, 239.5 is used).
+ * (`timestamp filename` per line), `groundtruth.txt` (camera poses
+ * `t tx ty tz qx qy qz qw`, camera -> world, optical axes X right, Y down,
+ * Z forward) and, optionally, `intrinsics.txt` (`width height fx fy cx cy`,
+ * an ofv addition; without it the TUM default 525, 525, 319.5, 239.5 is used).
+ * Images are PNG files of at most kMaxImageSide pixels a side; a depth image
+ * is 16-bit grey.
  */
 #pragma once
 
@@ -25,6 +27,9 @@ namespace ofv {
 struct TumSequenceOptions {
   double depth_factor = 5000.0;       ///< PNG value per metre (TUM: 5000)
   double max_time_difference = 0.02;  ///< largest rgb/depth timestamp gap when associating [s]
+  /// Largest gap between a depth image and its nearest ground-truth pose [s]:
+  /// a frame without a pose is an error, not the identity or the last pose.
+  double max_pose_time_difference = 0.02;
   std::optional<CameraIntrinsics> intrinsics;  ///< overrides intrinsics.txt and the default
 };
 
@@ -33,17 +38,17 @@ struct TumSequenceOptions {
  *
  * Frames follow depth.txt; each takes the colour image nearest in time
  * (within max_time_difference, otherwise no colour) and the ground-truth pose
- * interpolated at its time (identity without groundtruth.txt). Timestamps
- * are made relative to the first depth image.
+ * interpolated at its time. Timestamps are made relative to the first depth image.
  */
 class TumSequenceSource : public FrameSource {
  public:
   /// \throws std::runtime_error naming the path when the directory or its lists are missing or
-  /// broken.
+  /// broken; std::invalid_argument naming groundtruth.txt when it is missing or a depth image
+  /// has no pose within max_pose_time_difference (naming its timestamp).
   explicit TumSequenceSource(const std::string& directory, const TumSequenceOptions& options = {});
 
-  /// \throws std::runtime_error naming the file when an image is missing, unreadable or of the
-  /// wrong size.
+  /// \throws std::invalid_argument naming the file when an image is missing, not a PNG,
+  /// corrupt, larger than kMaxImageSide, of the wrong format (depth: 16-bit grey) or size.
   std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::string describe() const override;
   /// Number of frames in the sequence.

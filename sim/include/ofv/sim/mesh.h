@@ -10,6 +10,8 @@
 
 #include <Eigen/Geometry>
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -38,8 +40,20 @@ struct TriangleMesh {
  *        nx x ny cells on each face.
  */
 [[nodiscard]] TriangleMesh make_sheet(double size_x, double size_y, double thickness, int nx, int ny);
-/// \brief Reads a mesh file (any format Assimp reads), scaled by `scale`.
-/// \throws std::runtime_error naming the file when it cannot be read or has no triangles.
+/// \brief Largest mesh read_mesh() reads: vertices, triangles (PLY faces) and file size.
+constexpr std::size_t kMaxMeshVertices = 5'000'000;
+constexpr std::size_t kMaxMeshTriangles = 10'000'000;
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{512} << 20;
+
+/**
+ * \brief Reads a mesh file (any format Assimp reads), scaled by `scale`.
+ *
+ * A PLY file's header is checked before Assimp reads it (element counts
+ * within the limits and inside the file size); every scaled vertex must be
+ * finite and within 10 km of the origin.
+ * \throws std::runtime_error naming the file when it cannot be read, breaks these
+ * limits or has no triangles.
+ */
 [[nodiscard]] TriangleMesh read_mesh(const std::string& path, double scale = 1.0);
 
 /**
