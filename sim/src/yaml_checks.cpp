@@ -3,7 +3,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <set>
+#include <map>
 #include <stdexcept>
 
 namespace ofv::sim {
@@ -14,7 +14,8 @@ namespace {
   throw std::invalid_argument(source + ":" + std::to_string(at.Mark().line + 1) + ": " + what);
 }
 
-void walk(const YAML::Node& node, const std::string& source, int depth, std::size_t& nodes) {
+// `path`: where the node is (variants[0].set), for the messages.
+void walk(const YAML::Node& node, const std::string& source, const std::string& path, int depth, std::size_t& nodes) {
   if (++nodes > kMaxYamlNodes) {
     fail(node, source, "more than " + std::to_string(kMaxYamlNodes) + " nodes");
   }
@@ -22,19 +23,23 @@ void walk(const YAML::Node& node, const std::string& source, int depth, std::siz
     fail(node, source, "nested deeper than " + std::to_string(kMaxYamlDepth) + " levels");
   }
   if (node.IsMap()) {
-    std::set<std::string> keys;
+    std::map<std::string, int> first_line;
     for (const auto& item : node) {
-      if (item.first.IsScalar() && !keys.insert(item.first.Scalar()).second) {
-        std::string key = item.first.Scalar();
+      if (!item.first.IsScalar()) fail(item.first, source, "a key must be a word, not a list or a map");
+      std::string key = item.first.Scalar();
+      if (key.size() > 60) key = key.substr(0, 60) + "...";
+      const std::string at = path.empty() ? key : path + "." + key;
+      const auto [first, inserted] = first_line.emplace(key, item.first.Mark().line + 1);
+      if (!inserted) {
         fail(item.first, source,
-             "duplicate key '" + (key.size() > 60 ? key.substr(0, 60) + "..." : key) + "'");
+             "duplicate key '" + key + "' at " + at + " (first on line " + std::to_string(first->second) + ")");
       }
-      walk(item.first, source, depth + 1, nodes);
-      walk(item.second, source, depth + 1, nodes);
+      walk(item.second, source, at, depth + 1, nodes);
     }
   } else if (node.IsSequence()) {
+    std::size_t i = 0;
     for (const auto& item : node) {
-      walk(item, source, depth + 1, nodes);
+      walk(item, source, path + "[" + std::to_string(i++) + "]", depth + 1, nodes);
     }
   }
 }
@@ -43,7 +48,7 @@ void walk(const YAML::Node& node, const std::string& source, int depth, std::siz
 
 void check_yaml(const YAML::Node& root, const std::string& source) {
   std::size_t nodes = 0;
-  walk(root, source, 0, nodes);
+  walk(root, source, "", 0, nodes);
 }
 
 }  // namespace ofv::sim

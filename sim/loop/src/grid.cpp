@@ -1,6 +1,8 @@
 // The settings grid of `ofv compare`: YAML to a list of named variants.
 #include "ofv/loop/grid.h"
 
+#include "ofv/sim/yaml_checks.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -17,36 +19,6 @@ namespace {
 [[noreturn]] void grid_error(const std::string& source, const std::string& key,
                              const std::string& what) {
   throw std::invalid_argument(source + ": " + key + ": " + what);
-}
-
-// The text of a mapping's key; keys are plain words, never lists or maps.
-std::string key_text(const YAML::Node& key, const std::string& source, const std::string& at) {
-  if (!key.IsScalar()) {
-    grid_error(source + ":" + std::to_string(key.Mark().line + 1), at.empty() ? "(top level)" : at,
-               "expected a word as key");
-  }
-  return key.Scalar();
-}
-
-// yaml-cpp keeps every pair of a mapping but answers lookups with the first
-// of repeated keys, so a repeated key would be silently ignored: refuse it,
-// in every mapping of the file, naming the key and both lines.
-void check_unique_keys(const YAML::Node& n, const std::string& source, const std::string& at) {
-  if (n.IsSequence()) {
-    for (std::size_t i = 0; i < n.size(); ++i) check_unique_keys(n[i], source, at + "[" + std::to_string(i) + "]");
-  } else if (n.IsMap()) {
-    std::map<std::string, int> lines;  // key -> first line (1-based)
-    for (const auto& item : n) {
-      const std::string key = key_text(item.first, source, at);
-      const int line = item.first.Mark().line + 1;
-      const auto [first, inserted] = lines.emplace(key, line);
-      if (!inserted) {
-        grid_error(source + ":" + std::to_string(line), at.empty() ? key : at + "." + key,
-                   "duplicate key '" + key + "' (first on line " + std::to_string(first->second) + ")");
-      }
-      check_unique_keys(item.second, source, at.empty() ? key : at + "." + key);
-    }
-  }
 }
 
 std::string scalar_text(const YAML::Node& n, const std::string& source, const std::string& key) {
@@ -77,7 +49,7 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
     throw std::invalid_argument(source + ": invalid YAML: " + e.what());
   }
   if (!root.IsMap()) throw std::invalid_argument(source + ": expected a map with 'variants' and/or 'axes'");
-  check_unique_keys(root, source, "");
+  sim::check_yaml(root, source);  // repeated keys, keys that are not words, depth, size
   Grid grid;
   std::vector<Variant> base;
   std::vector<std::pair<std::string, std::string>> common;

@@ -22,9 +22,10 @@ constexpr std::size_t kMaxYamlNodes = 100000;
 
 /**
  * \brief Checks a document read from `source` (a file name, for the messages).
- * \throws std::invalid_argument "SOURCE:LINE: duplicate key 'KEY'" for a key
- *         repeated in one map, and naming the file and line when the document
- *         nests deeper than kMaxYamlDepth or has more than kMaxYamlNodes nodes.
+ * \throws std::invalid_argument "SOURCE:LINE: duplicate key 'KEY' at PATH
+ *         (first on line N)" for a key repeated in one map; naming the file
+ *         and line for a key that is not a word, and when the document nests
+ *         deeper than kMaxYamlDepth or has more than kMaxYamlNodes nodes.
  */
 void check_yaml(const YAML::Node& root, const std::string& source);
 
