@@ -138,7 +138,7 @@ TEST(SceneJson, SetParamParsesEachType) {
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
            {"speed", "1"}, {"r_seed", "abc"}, {"r_seed", "0.02m"}, {"r_seed", "-1"},
            {"step", "nan"}, {"step", "1e999"}, {"step", "0"}, {"max_iterations", "1.5"}, {"warm_start", "maybe"},
-           {"preset", "quick"}}) {
+           {"preset", "quick"}, {"r_sphere", "1e300"}, {"time_budget", "0"}, {"time_budget", "1e9"}}) {
     try {
       EstimatorParams q = p;
       set_param(q, name, value);  // a number of the wrong range fails at resolve()
@@ -148,7 +148,7 @@ TEST(SceneJson, SetParamParsesEachType) {
       EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
     }
   }
-  EXPECT_EQ(param_names().size(), 10U);
+  EXPECT_EQ(param_names().size(), 11U);
 }
 
 TEST(SceneJson, ResultHasEverySpecField) {
