@@ -4,6 +4,7 @@
 #include "ofv/servo/target_pose.h"
 
 #include <chrono>
+#include <cmath>
 
 namespace ofv {
 
@@ -26,12 +27,15 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       std::optional<RgbdFrame> frame = source.next();
       if (!frame) break;
       const auto arrived = Clock::now();
-      if (!first_stamp) first_stamp = frame->timestamp;
-      if (frame->timestamp - *first_stamp > options.max_duration + 1e-9) break;
+      // A timestamp that is not finite stops this frame (the safety filter
+      // refuses its period) but is not the time base of the next ones.
+      const bool stamped = std::isfinite(frame->timestamp);
+      if (!first_stamp && stamped) first_stamp = frame->timestamp;
+      if (stamped && first_stamp && frame->timestamp - *first_stamp > options.max_duration + 1e-9) break;
       if (options.pose_from_robot) frame->wMc = to_eigen(robot.wMc());
       const double gap = last_stamp ? frame->timestamp - *last_stamp : 0.0;
       const double dt = last_stamp ? gap : options.first_period;
-      last_stamp = frame->timestamp;
+      if (stamped) last_stamp = frame->timestamp;
 
       RobotLoopFrame out;
       out.index = summary.frames;
@@ -54,7 +58,9 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age, shown);
       out.step = &step;
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
-      if (options.move_robot) (void)robot.step(step.velocity, dt);
+      // A period that is not finite and positive (a timestamp going backwards
+      // or NaN) came with a stop: the robot gets no period it cannot integrate.
+      if (options.move_robot) (void)robot.step(step.velocity, std::isfinite(dt) && dt > 0.0 ? dt : 0.0);
       ++summary.frames;
       if (observer) observer(out);
     }
