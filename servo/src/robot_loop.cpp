@@ -25,7 +25,9 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
     while (options.stop == nullptr || *options.stop == 0) {
       const auto asked = Clock::now();
       std::optional<RgbdFrame> frame = source.next();
-      if (!frame) break;
+      // A stop requested while the frame was awaited (a signal during a
+      // blocking read) wins over the frame: no command after it but the stop.
+      if (!frame || (options.stop != nullptr && *options.stop != 0)) break;
       const auto arrived = Clock::now();
       // A timestamp that is not finite stops this frame (the safety filter
       // refuses its period) but is not the time base of the next ones.
@@ -65,7 +67,12 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       if (observer) observer(out);
     }
   } catch (...) {
-    rest();
+    // Stop, then report the error that ended the run, not the stop's own
+    // (a robot that refuses every command throws again here).
+    try {
+      rest();
+    } catch (...) {
+    }
     throw;
   }
   summary.stopped = options.stop != nullptr && *options.stop != 0;

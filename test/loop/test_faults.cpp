@@ -376,7 +376,7 @@ TEST(Faults, ARobotThatThrowsOnceIsStoppedAndTheErrorReported) {
   check_invariants(r, limits());
 }
 
-TEST(Faults, DISABLED_ARobotThatRefusesEverythingReportsTheFirstError) {
+TEST(Faults, ARobotThatRefusesEverythingReportsTheFirstError) {
   // The stop is tried too; its failure must not hide the first one.
   FaultPlan plan;
   plan.robot_fails_at = 8;
@@ -407,7 +407,7 @@ TEST(Faults, EveryOtherExitPathEndsWithAStop) {
   }
 }
 
-TEST(Faults, DISABLED_AStopRequestedWhileAFrameIsAwaitedSendsNothingButTheStop) {
+TEST(Faults, AStopRequestedWhileAFrameIsAwaitedSendsNothingButTheStop) {
   FaultPlan plan;
   plan.source = std::vector<Injection>{{10, Fault::Stop}};
   const FaultRun r = replay(plan);
