@@ -473,7 +473,7 @@ TEST(FaultsCli, AGapInARecordingStopsTheRobotForThatFrame) {
   EXPECT_EQ(lines.back().status, "stop");
 }
 
-TEST(FaultsCli, DISABLED_AMissingDepthImagePrintsTheStopAndFails) {
+TEST(FaultsCli, AMissingDepthImagePrintsTheStopAndFails) {
   // The source fails mid-run: the stop line comes first, then the error (exit 2: the recording is invalid).
   const fs::path dir = retimed_copy("faults_missing", [](long, double t) { return t; });
   std::string depth_file;
@@ -530,6 +530,54 @@ TEST(FaultsCli, DryRunLinesAreFlushedAsTheyAreProducedAndSigtermStops) {
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines.back().status, "stop");
   EXPECT_LT(lines.size(), 300U);  // well before the 30 s
+}
+
+// The SIGTERM bit of /proc/PID/status's SigCgt: the process catches SIGTERM.
+bool catches_sigterm(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("SigCgt:", 0) == 0) return ((std::stoull(line.substr(7), nullptr, 16) >> (SIGTERM - 1)) & 1U) != 0;
+  }
+  return false;
+}
+
+TEST(FaultsCli, SigtermDuringStartUpStillEndsWithTheStop) {
+  // As soon as ofv run catches SIGTERM (before it loads the scenario and
+  // starts the threaded arm), a SIGTERM ends it with the stop line and exit 0.
+  int out[2];
+  ASSERT_EQ(pipe(out), 0);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    dup2(out[1], STDOUT_FILENO);
+    close(out[0]);
+    close(out[1]);
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, STDERR_FILENO);
+    execl(OFV_BINARY, OFV_BINARY, "run", "--robot", "afma6", "--source", "sim:dvd-one-hand", "--set", "duration=30",
+          "--dry-run", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(out[1]);
+  const auto start = std::chrono::steady_clock::now();
+  while (!catches_sigterm(pid) && std::chrono::steady_clock::now() - start < std::chrono::seconds(20)) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  kill(pid, SIGTERM);
+  FILE* in = fdopen(out[0], "r");
+  ASSERT_NE(in, nullptr);
+  std::string text;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, in)) > 0;) text.append(buffer, n);
+  std::fclose(in);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const std::vector<Line> lines = dry_run_lines(text);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines.back().status, "stop");
+  EXPECT_LT(lines.size(), 300U);
 }
 
 }  // namespace
