@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace ofv {
 namespace {
 
@@ -94,6 +96,35 @@ TEST(Episode, SettingsAreValidatedByName) {
   // Lengths may refer to the scenario's radii.
   const EpisodeSetup r = resolve_episode(s, {{"push_radius", "r_seed"}});
   EXPECT_DOUBLE_EQ(r.loop.estimator.resolve().push_radius, 0.02);
+}
+
+TEST(Episode, LengthIsBoundedHoweverTheSetupWasMade) {
+  // A setup made in code skips the settings' bounds: run_episode checks the
+  // number of frames before it becomes an integer (1e20 s once gave 0 steps).
+  const EpisodeSetup s = resolve_episode(sim::load_scenario(kOnRay), {{"perception", "ground-truth"}});
+  const auto refused = [](EpisodeSetup bad, const std::string& word) {
+    try {
+      (void)run_episode(bad);
+      ADD_FAILURE() << word << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+    }
+  };
+  for (const double d : {1e20, kMaxEpisodeDuration * 1.01, -1.0, std::nan(""), HUGE_VAL}) {
+    EpisodeSetup bad = s;
+    bad.duration = d;
+    refused(bad, "duration");
+  }
+  for (const double r : {0.0, -30.0, std::nan(""), HUGE_VAL}) {
+    EpisodeSetup bad = s;
+    bad.scenario.rate = r;
+    refused(bad, "rate");
+  }
+  EpisodeSetup fast = s;  // in range each, too many frames together
+  fast.duration = kMaxEpisodeDuration;
+  fast.scenario.rate = 1e9;
+  refused(fast, "frames");
+  EXPECT_THROW((void)resolve_episode(sim::load_scenario(kOnRay), {{"duration", "1e20"}}), std::invalid_argument);
 }
 
 }  // namespace
