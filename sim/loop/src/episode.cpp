@@ -36,12 +36,12 @@ SettingsTable<EpisodeSetup> make_table() {
           e.perception = parse_word<PerceptionMode>("perception", v,
                                                     {{"full", PerceptionMode::Full}, {"ground-truth", PerceptionMode::GroundTruth}});
         });
-  t.add({"duration", "number", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
+  t.add({"duration", "number in (0, 86400]", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
         [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, kMaxEpisodeDuration, true); });
-  t.add({"seed", "integer", std::to_string(d.seed), "",
+  t.add({"seed", "integer in [0, 1000000000]", std::to_string(d.seed), "",
          "the scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement"},
         [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); });
-  t.add({"latency", "integer", std::to_string(d.latency), "frames",
+  t.add({"latency", "integer in [0, 30]", std::to_string(d.latency), "frames",
          "delay between capturing a frame and applying its command (simulation), 0 to 30"},
         [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
