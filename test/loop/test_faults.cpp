@@ -73,6 +73,7 @@ enum class Fault {
   Backwards,   ///< this frame and the next ones `amount` s earlier
   NanTime,     ///< a NaN timestamp
   PoseJump,    ///< the frame's pose moved by `amount` m along x
+  NanPose,     ///< a NaN in the frame's pose
   Throw,       ///< the source throws
   Stop,        ///< the stop flag is raised while the frame is awaited (a signal)
 };
@@ -109,6 +110,7 @@ class FaultySource : public FrameSource {
           case Fault::Backwards: shift_ -= i.amount; break;
           case Fault::NanTime: break;
           case Fault::PoseJump: f->wMc.translation().x() += i.amount; break;
+          case Fault::NanPose: f->wMc.translation().y() = std::numeric_limits<double>::quiet_NaN(); break;
           case Fault::Throw: throw std::runtime_error("source fault at frame " + std::to_string(k));
           case Fault::Stop: *stop_ = 1; break;
           case Fault::None: break;
@@ -252,7 +254,7 @@ void check_invariants(const FaultRun& run, const SafetySettings& limits) {
     const double gap = last ? d.timestamp - *last : 0.0;  // NaN for a NaN timestamp
     const bool stale = k > 0 && !(gap > 0.0 && gap <= limits.stale_timeout);
     if (std::isfinite(d.timestamp)) last = d.timestamp;
-    const bool blind = d.fault == Fault::NoDepth || d.fault == Fault::NanDepth;
+    const bool blind = d.fault == Fault::NoDepth || d.fault == Fault::NanDepth || d.fault == Fault::NanPose;
     if (stale || blind) {
       EXPECT_TRUE(is_zero(run.commands[k].v)) << "frame " << k << " must stop the robot";
     }
@@ -345,6 +347,20 @@ TEST(Faults, PoseJumpsKeepTheLimits) {
   const FaultRun r = replay(plan);
   EXPECT_FALSE(r.error);
   check_invariants(r, limits());
+}
+
+TEST(Faults, APoseThatIsNotFiniteOrFarAwayEndsTheRunWithAStop) {
+  // Perception refuses it (it once reached PCL's octree, which aborted the
+  // process: no stop); the loop stops the robot and reports.
+  for (const Injection& bad : {Injection{8, Fault::NanPose}, Injection{8, Fault::PoseJump, 1e7}}) {
+    FaultPlan plan;
+    plan.source = std::vector<Injection>{bad};
+    const FaultRun r = replay(plan);
+    ASSERT_TRUE(r.error);
+    EXPECT_NE(r.error->find("wMc"), std::string::npos) << *r.error;
+    EXPECT_EQ(r.commands.size(), 9U);  // 8 frames, then the stop
+    check_invariants(r, limits());
+  }
 }
 
 TEST(Faults, ASourceThatThrowsLeavesTheRobotAtRest) {
