@@ -42,7 +42,6 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       RobotLoopFrame out;
       out.index = summary.frames;
       out.frame = &*frame;
-      out.dt = dt;
       out.source_s = std::chrono::duration<double>(arrived - asked).count();
       std::optional<ViewProblem> problem;
       std::optional<double> shown;
@@ -62,7 +61,8 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
       // A period that is not finite and positive (a timestamp going backwards
       // or NaN) came with a stop: the robot gets no period it cannot integrate.
-      if (options.move_robot) (void)robot.step(step.velocity, std::isfinite(dt) && dt > 0.0 ? dt : 0.0);
+      out.dt = std::isfinite(dt) && dt > 0.0 ? dt : 0.0;
+      if (options.move_robot) (void)robot.step(step.velocity, out.dt);
       ++summary.frames;
       if (observer) observer(out);
     }

@@ -47,7 +47,7 @@ struct RobotLoopFrame {
   const RgbdFrame* frame = nullptr;
   const PerceptionResult* perception = nullptr;  ///< nullptr with a problem_source
   const LoopStep* step = nullptr;
-  double dt = 0.0;         ///< period the command is applied for [s]
+  double dt = 0.0;         ///< period the command is applied for [s] (0 with a timestamp that does not increase)
   double frame_age = 0.0;  ///< [s]
   double source_s = 0.0;      ///< time spent waiting for and reading the frame [s]
   double perception_s = 0.0;  ///< compute time of perception [s]
