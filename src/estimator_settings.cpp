@@ -134,9 +134,9 @@ SettingsTable<EstimatorParams> make_table() {
         [](P& p, const std::string& v) {
           p.preset = parse_word<Preset>("preset", v, {{"paper", Preset::Paper}, {"authors_code", Preset::AuthorsCode}});
         });
-  t.add({"r_seed", "number in (0, 10000]", format_number(d.r_seed), "m", "supervoxel seed resolution R_seed"},
+  t.add({"r_seed", "number in (0, 1e4]", format_number(d.r_seed), "m", "supervoxel seed resolution R_seed"},
         [](P& p, const std::string& v) { p.r_seed = parse_number("r_seed", v, -kInf, kInf, false); });
-  t.add({"r_sphere", "number in (0, 10000]", format_number(d.r_sphere), "m", "radius of the solution sphere around the object"},
+  t.add({"r_sphere", "number in (0, 1e4]", format_number(d.r_sphere), "m", "radius of the solution sphere around the object"},
         [](P& p, const std::string& v) { p.r_sphere = parse_number("r_sphere", v, -kInf, kInf, false); });
   t.add({"initial_view", "spherical_mean | vector_mean", to_string(d.initial_view), "",
          "how t0 averages the normals-to-sphere rays"},
@@ -144,10 +144,10 @@ SettingsTable<EstimatorParams> make_table() {
           p.initial_view = parse_word<InitialView>(
               "initial_view", v, {{"spherical_mean", InitialView::SphericalMean}, {"vector_mean", InitialView::VectorMean}});
         });
-  t.add({"clearance", "number in (0, 10000] | r_seed | r_sphere", format_number(d.clearance), "m",
+  t.add({"clearance", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.clearance), "m",
          "the view is clear when no projected occlusion point is closer (paper: r_seed)"},
         [](P& p, const std::string& v) { p.clearance = length(p, "clearance", v); });
-  t.add({"push_radius", "number in (0, 10000] | r_seed | r_sphere", format_number(d.push_radius), "m",
+  t.add({"push_radius", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.push_radius), "m",
          "projected points closer than this push the view (paper: r_sphere; r_seed is the other reading)"},
         [](P& p, const std::string& v) { p.push_radius = length(p, "push_radius", v); });
   t.add({"push_weighting", "sum | inverse_distance", to_string(d.push_weighting), "",
@@ -156,10 +156,10 @@ SettingsTable<EstimatorParams> make_table() {
           p.push_weighting = parse_word<PushWeighting>(
               "push_weighting", v, {{"sum", PushWeighting::Sum}, {"inverse_distance", PushWeighting::InverseDistance}});
         });
-  t.add({"step", "number in (0, 10000] | r_seed | r_sphere", format_number(d.step), "m",
+  t.add({"step", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.step), "m",
          "length of one push on the tangent plane (paper: r_seed)"},
         [](P& p, const std::string& v) { p.step = length(p, "step", v); });
-  t.add({"max_iterations", "integer in [0, 2147483647]", std::to_string(d.max_iterations), "",
+  t.add({"max_iterations", "integer >= 0", std::to_string(d.max_iterations), "",
          "push steps before giving up with the best visited view"},
         [](P& p, const std::string& v) { p.max_iterations = static_cast<int>(parse_integer("max_iterations", v, 0, INT_MAX)); });
   t.add({"warm_start", "bool", format_bool(d.warm_start), "", "start from the previous frame's view instead of t0"},
