@@ -116,12 +116,17 @@ class CommandLines {
       first = false;
     }
     std::fprintf(out_, "]}\n");
-    std::fflush(out_);
+    std::fflush(out_);  // a line is readable as soon as its command is decided
+    next_frame_ = frame + 1;
+    last_t_ = t;
   }
 
-  /// The final stop line, then stdout back to what it was.
+  /// The final stop line (zero velocity), then stdout back to what it was.
+  /// The destructor calls it: every exit path, an exception too, ends with
+  /// the stop line before the error is reported.
   void close() {
     if (!out_) return;
+    print(next_frame_, last_t_, "stop", vpColVector(6, 0.0), "");
     std::fclose(out_);
     out_ = nullptr;
     std::cout.flush();
@@ -133,6 +138,8 @@ class CommandLines {
  private:
   std::FILE* out_ = nullptr;
   int saved_ = -1;
+  long next_frame_ = 0;
+  double last_t_ = 0.0;
 };
 
 }  // namespace
@@ -160,11 +167,18 @@ Command add_run_command(CLI::App& app) {
       ->type_name("NAME=VALUE");
   sub->add_flag("--dry-run", opt->dry_run,
                 "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
-  sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits. The object is picked in the first frame "
-              "(the cluster nearest the image centre); when it is lost, or a frame is stale, the robot stops.\n\n" +
+  sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits (0). The object is picked in the first frame "
+              "(the cluster nearest the image centre); when it is lost, or a frame is stale (older than stale_timeout "
+              "after the previous one, or not after it), the robot stops. An error mid-run (the source, perception or "
+              "the robot fails) stops the robot, then is reported (exit 2 for an invalid recording, 1 otherwise). A dry "
+              "run's lines are flushed one by one; the last one is always the stop.\n\n" +
               episode_settings_help());
 
   return {sub, [opt]() -> int {
+            // First: a signal during start-up (loading a scenario, starting a
+            // driver) must end the run with a stop too, not kill it.
+            std::signal(SIGINT, on_signal);
+            std::signal(SIGTERM, on_signal);
             const bool simulated = opt->source.rfind("sim:", 0) == 0;
             const bool real = opt->robot.size() > 5 && opt->robot.compare(opt->robot.size() - 5, 5, "-real") == 0;
             EpisodeSetup setup;
@@ -199,8 +213,6 @@ Command add_run_command(CLI::App& app) {
               std::cerr << "ofv run: " << e.what() << '\n';
               return kUsage;
             }
-            std::signal(SIGINT, on_signal);
-            std::signal(SIGTERM, on_signal);
             try {
               CommandLines lines(opt->dry_run);
               const auto print = [&](const RobotLoopFrame& f) {
@@ -209,7 +221,6 @@ Command add_run_command(CLI::App& app) {
               };
               if (simulated) {
                 const EpisodeOutcome outcome = rehearse(setup, &g_stop, print);
-                lines.print(outcome.metrics.steps, outcome.metrics.duration, "stop", vpColVector(6, 0.0), "");
                 lines.close();
                 std::cout << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
                           << (g_stop ? ", stopped" : "") << '\n'
@@ -222,12 +233,11 @@ Command add_run_command(CLI::App& app) {
               options.max_duration = setup.duration;
               options.stop = &g_stop;
               const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
-              lines.print(summary.frames, 0.0, "stop", vpColVector(6, 0.0), "");
               lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
                         << (summary.stopped ? ", stopped by a signal" : "") << '\n';
               return kOk;
-            } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims
+            } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims (after the stop line)
               std::cerr << "ofv run: " << e.what() << '\n';
               return kUsage;
             } catch (const std::exception& e) {

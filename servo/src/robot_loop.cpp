@@ -4,6 +4,7 @@
 #include "ofv/servo/target_pose.h"
 
 #include <chrono>
+#include <cmath>
 
 namespace ofv {
 
@@ -24,19 +25,23 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
     while (options.stop == nullptr || *options.stop == 0) {
       const auto asked = Clock::now();
       std::optional<RgbdFrame> frame = source.next();
-      if (!frame) break;
+      // A stop requested while the frame was awaited (a signal during a
+      // blocking read) wins over the frame: no command after it but the stop.
+      if (!frame || (options.stop != nullptr && *options.stop != 0)) break;
       const auto arrived = Clock::now();
-      if (!first_stamp) first_stamp = frame->timestamp;
-      if (frame->timestamp - *first_stamp > options.max_duration + 1e-9) break;
+      // A timestamp that is not finite stops this frame (the safety filter
+      // refuses its period) but is not the time base of the next ones.
+      const bool stamped = std::isfinite(frame->timestamp);
+      if (!first_stamp && stamped) first_stamp = frame->timestamp;
+      if (stamped && first_stamp && frame->timestamp - *first_stamp > options.max_duration + 1e-9) break;
       if (options.pose_from_robot) frame->wMc = to_eigen(robot.wMc());
       const double gap = last_stamp ? frame->timestamp - *last_stamp : 0.0;
       const double dt = last_stamp ? gap : options.first_period;
-      last_stamp = frame->timestamp;
+      if (stamped) last_stamp = frame->timestamp;
 
       RobotLoopFrame out;
       out.index = summary.frames;
       out.frame = &*frame;
-      out.dt = dt;
       out.source_s = std::chrono::duration<double>(arrived - asked).count();
       std::optional<ViewProblem> problem;
       std::optional<double> shown;
@@ -54,12 +59,20 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age, shown);
       out.step = &step;
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
-      if (options.move_robot) (void)robot.step(step.velocity, dt);
+      // A period that is not finite and positive (a timestamp going backwards
+      // or NaN) came with a stop: the robot gets no period it cannot integrate.
+      out.dt = std::isfinite(dt) && dt > 0.0 ? dt : 0.0;
+      if (options.move_robot) (void)robot.step(step.velocity, out.dt);
       ++summary.frames;
       if (observer) observer(out);
     }
   } catch (...) {
-    rest();
+    // Stop, then report the error that ended the run, not the stop's own
+    // (a robot that refuses every command throws again here).
+    try {
+      rest();
+    } catch (...) {
+    }
     throw;
   }
   summary.stopped = options.stop != nullptr && *options.stop != 0;

@@ -56,12 +56,12 @@ SettingsTable<LoopSettings> make_table() {
                                              {"initial_view", ViewMethod::InitialView},
                                              {"sampling", ViewMethod::Sampling}});
         });
-  t.add({"sampling_candidates", "integer", std::to_string(d.sampling.candidates), "",
+  t.add({"sampling_candidates", "integer in [1, 1000000]", std::to_string(d.sampling.candidates), "",
          "candidate views on the sphere of method=sampling (Fibonacci lattice), 1 to 1e6"},
         [](L& l, const std::string& v) {
           l.sampling.candidates = static_cast<int>(parse_integer("sampling_candidates", v, 1, 1000000));
         });
-  t.add({"sampling_occluder_radius", "number", format_number(d.sampling.occluder_radius), "m",
+  t.add({"sampling_occluder_radius", "number in (0, 1]", format_number(d.sampling.occluder_radius), "m",
          "method=sampling: an occluder point blocks lines of sight passing closer than this"},
         [](L& l, const std::string& v) {
           l.sampling.occluder_radius = parse_number("sampling_occluder_radius", v, 0.0, 1.0, true);
@@ -72,24 +72,24 @@ SettingsTable<LoopSettings> make_table() {
           l.controller.law = parse_word<ControllerSettings::Law>(
               "controller", v, {{"sphere", ControllerSettings::Law::Sphere}, {"pbvs", ControllerSettings::Law::Pbvs}});
         });
-  t.add({"gain", "number", format_number(d.controller.gain), "1/s",
+  t.add({"gain", "number in (0, 100]", format_number(d.controller.gain), "1/s",
          "lambda: the error decays as exp(-gain t) until the speed limits bind"},
         [](L& l, const std::string& v) { l.controller.gain = parse_number("gain", v, 0.0, 100.0, true); });
   t.add({"adaptive_gain", "bool", format_bool(d.controller.adaptive_gain), "",
          "twice the gain near zero error, the gain far away (vpAdaptiveGain)"},
         [](L& l, const std::string& v) { l.controller.adaptive_gain = parse_bool("adaptive_gain", v); });
-  t.add({"max_linear_speed", "number", format_number(d.controller.max_linear_speed), "m/s",
+  t.add({"max_linear_speed", "number in (0, 10]", format_number(d.controller.max_linear_speed), "m/s",
          "the controller scales the linear velocity down to this; the safety filter enforces it"},
         [](L& l, const std::string& v) {
           l.controller.max_linear_speed = l.safety.max_linear_speed = parse_number("max_linear_speed", v, 0.0, 10.0, true);
         });
-  t.add({"max_angular_speed", "number", format_number(d.controller.max_angular_speed), "rad/s",
+  t.add({"max_angular_speed", "number in (0, 20]", format_number(d.controller.max_angular_speed), "rad/s",
          "the controller scales the angular velocity down to this; the safety filter enforces it"},
         [](L& l, const std::string& v) {
           l.controller.max_angular_speed = l.safety.max_angular_speed =
               parse_number("max_angular_speed", v, 0.0, 20.0, true);
         });
-  t.add({"target_filter", "number", format_number(d.controller.target_filter), "s",
+  t.add({"target_filter", "number in [0, 10]", format_number(d.controller.target_filter), "s",
          "time constant of a low-pass on the target position; 0 = off"},
         [](L& l, const std::string& v) { l.controller.target_filter = parse_number("target_filter", v, 0.0, 10.0, false); });
   t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",
@@ -101,45 +101,45 @@ SettingsTable<LoopSettings> make_table() {
           l.anticipation.mode = parse_word<Anticipation>("anticipation", v,
                                                          {{"off", Anticipation::Off}, {"predict", Anticipation::Predict}});
         });
-  t.add({"anticipation_horizon", "number", format_number(d.anticipation.horizon), "s",
+  t.add({"anticipation_horizon", "number in (0, 5]", format_number(d.anticipation.horizon), "s",
          "anticipation=predict: how far ahead the occluders' motion is followed"},
         [](L& l, const std::string& v) {
           l.anticipation.horizon = parse_number("anticipation_horizon", v, 0.0, 5.0, true);
         });
-  t.add({"anticipation_samples", "integer", std::to_string(d.anticipation.samples), "",
+  t.add({"anticipation_samples", "integer in [1, 10]", std::to_string(d.anticipation.samples), "",
          "anticipation=predict: predicted copies of a moving occluder over the horizon, 1 to 10"},
         [](L& l, const std::string& v) {
           l.anticipation.samples = static_cast<int>(parse_integer("anticipation_samples", v, 1, 10));
         });
-  t.add({"anticipation_min_speed", "number", format_number(d.anticipation.min_speed), "m/s",
+  t.add({"anticipation_min_speed", "number in [0, 10]", format_number(d.anticipation.min_speed), "m/s",
          "anticipation=predict: occluders tracked slower than this are taken as still"},
         [](L& l, const std::string& v) {
           l.anticipation.min_speed = parse_number("anticipation_min_speed", v, 0.0, 10.0, false);
         });
-  t.add({"track_link_distance", "number", format_number(d.tracker.link_distance), "m",
+  t.add({"track_link_distance", "number in (0, 1]", format_number(d.tracker.link_distance), "m",
          "occluder tracks: points closer than this are one occluder"},
         [](L& l, const std::string& v) {
           l.tracker.link_distance = parse_number("track_link_distance", v, 0.0, 1.0, true);
         });
-  t.add({"track_gate", "number", format_number(d.tracker.gate), "m",
+  t.add({"track_gate", "number in (0, 10]", format_number(d.tracker.gate), "m",
          "occluder tracks: largest distance of an occluder's centroid from its track's prediction"},
         [](L& l, const std::string& v) { l.tracker.gate = parse_number("track_gate", v, 0.0, 10.0, true); });
-  t.add({"track_accel_noise", "number", format_number(d.tracker.accel_noise), "m/s^2",
+  t.add({"track_accel_noise", "number in (0, 1000]", format_number(d.tracker.accel_noise), "m/s^2",
          "occluder tracks: white-noise acceleration of the constant-velocity Kalman filter"},
         [](L& l, const std::string& v) {
           l.tracker.accel_noise = parse_number("track_accel_noise", v, 0.0, 1000.0, true);
         });
-  t.add({"track_measurement_noise", "number", format_number(d.tracker.measurement_noise), "m",
+  t.add({"track_measurement_noise", "number in (0, 1]", format_number(d.tracker.measurement_noise), "m",
          "occluder tracks: standard deviation of an occluder's measured centroid"},
         [](L& l, const std::string& v) {
           l.tracker.measurement_noise = parse_number("track_measurement_noise", v, 0.0, 1.0, true);
         });
-  t.add({"track_confirm_hits", "integer", std::to_string(d.tracker.confirm_hits), "",
+  t.add({"track_confirm_hits", "integer in [1, 1000]", std::to_string(d.tracker.confirm_hits), "",
          "occluder tracks: frames seen before a track is used, 1 to 1000"},
         [](L& l, const std::string& v) {
           l.tracker.confirm_hits = static_cast<int>(parse_integer("track_confirm_hits", v, 1, 1000));
         });
-  t.add({"track_max_misses", "integer", std::to_string(d.tracker.max_misses), "",
+  t.add({"track_max_misses", "integer in [0, 1000]", std::to_string(d.tracker.max_misses), "",
          "occluder tracks: frames unseen before a track is dropped, 0 to 1000"},
         [](L& l, const std::string& v) {
           l.tracker.max_misses = static_cast<int>(parse_integer("track_max_misses", v, 0, 1000));
@@ -150,24 +150,24 @@ SettingsTable<LoopSettings> make_table() {
           l.no_free_view.mode = parse_word<NoFreeView>(
               "no_free_view", v, {{"best_iterate", NoFreeView::BestIterate}, {"most_visible", NoFreeView::MostVisible}});
         });
-  t.add({"retreat_drop", "number", format_number(d.no_free_view.retreat_drop), "",
+  t.add({"retreat_drop", "number in [0, 1]", format_number(d.no_free_view.retreat_drop), "",
          "the fraction of the object the camera may see less, after moving, than at the view it has been at that "
          "showed the most, before it goes back there and holds (unless the occluders came there too), 0 (off) to 1"},
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); });
-  t.add({"no_free_view_margin", "number", format_number(d.no_free_view.margin), "",
+  t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
          "no_free_view=most_visible: a view must see this fraction more of the object than the current one, 0 to 1"},
         [](L& l, const std::string& v) {
           l.no_free_view.margin = parse_number("no_free_view_margin", v, 0.0, 1.0, false);
         });
-  t.add({"max_linear_accel", "number", format_number(d.safety.max_linear_accel), "m/s^2",
+  t.add({"max_linear_accel", "number in (0, 100]", format_number(d.safety.max_linear_accel), "m/s^2",
          "safety filter: largest change of the linear velocity"},
         [](L& l, const std::string& v) { l.safety.max_linear_accel = parse_number("max_linear_accel", v, 0.0, 100.0, true); });
-  t.add({"max_angular_accel", "number", format_number(d.safety.max_angular_accel), "rad/s^2",
+  t.add({"max_angular_accel", "number in (0, 1000]", format_number(d.safety.max_angular_accel), "rad/s^2",
          "safety filter: largest change of the angular velocity"},
         [](L& l, const std::string& v) {
           l.safety.max_angular_accel = parse_number("max_angular_accel", v, 0.0, 1000.0, true);
         });
-  t.add({"stale_timeout", "number", format_number(d.safety.stale_timeout), "s",
+  t.add({"stale_timeout", "number in (0, 60]", format_number(d.safety.stale_timeout), "s",
          "safety filter: a frame older than this when its command is sent stops the robot"},
         [](L& l, const std::string& v) { l.safety.stale_timeout = parse_number("stale_timeout", v, 0.0, 60.0, true); });
   t.add({"workspace", "none | xmin,ymin,zmin,xmax,ymax,zmax", "none", "m",

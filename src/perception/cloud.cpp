@@ -1,7 +1,10 @@
 // Back-projection, crop and voxelisation of an RgbdFrame (no PCL needed here).
 #include "ofv/perception/cloud.h"
 
+#include "ofv/estimator.h"
+
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -21,6 +24,16 @@ void check_frame(const RgbdFrame& frame) {
   if (frame.depth.size() != n) {
     throw std::invalid_argument("RgbdFrame: depth has " + std::to_string(frame.depth.size()) +
                                 " values, expected " + std::to_string(n));
+  }
+  // A pose PCL's octree cannot take (NaN, or farther than any length ofv
+  // accepts) would abort the process inside PCL, where no one can stop the robot.
+  const Eigen::Matrix4d& m = frame.wMc.matrix();
+  const Eigen::Matrix3d R = frame.wMc.linear();
+  if (!m.allFinite() || frame.wMc.translation().norm() > kMaxLength ||
+      !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0.0) {
+    std::ostringstream text;
+    text << "RgbdFrame: wMc is not a rigid transform within " << kMaxLength << " m of the origin:\n" << m;
+    throw std::invalid_argument(text.str());
   }
   if (!frame.rgb.empty() && frame.rgb.size() != 3 * n) {
     throw std::invalid_argument("RgbdFrame: rgb has " + std::to_string(frame.rgb.size()) +

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace ofv {
 namespace {
 
@@ -94,6 +97,76 @@ TEST(Episode, SettingsAreValidatedByName) {
   // Lengths may refer to the scenario's radii.
   const EpisodeSetup r = resolve_episode(s, {{"push_radius", "r_seed"}});
   EXPECT_DOUBLE_EQ(r.loop.estimator.resolve().push_radius, 0.02);
+}
+
+TEST(Episode, LengthIsBoundedHoweverTheSetupWasMade) {
+  // A setup made in code skips the settings' bounds: run_episode checks the
+  // number of frames before it becomes an integer (1e20 s once gave 0 steps).
+  const EpisodeSetup s = resolve_episode(sim::load_scenario(kOnRay), {{"perception", "ground-truth"}});
+  const auto refused = [](EpisodeSetup bad, const std::string& word) {
+    try {
+      (void)run_episode(bad);
+      ADD_FAILURE() << word << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+    }
+  };
+  for (const double d : {1e20, kMaxEpisodeDuration * 1.01, -1.0, std::nan(""), HUGE_VAL}) {
+    EpisodeSetup bad = s;
+    bad.duration = d;
+    refused(bad, "duration");
+  }
+  for (const double r : {0.0, -30.0, std::nan(""), HUGE_VAL}) {
+    EpisodeSetup bad = s;
+    bad.scenario.rate = r;
+    refused(bad, "rate");
+  }
+  EpisodeSetup fast = s;  // in range each, too many frames together
+  fast.duration = kMaxEpisodeDuration;
+  fast.scenario.rate = 1e9;
+  refused(fast, "frames");
+  EXPECT_THROW((void)resolve_episode(sim::load_scenario(kOnRay), {{"duration", "1e20"}}), std::invalid_argument);
+}
+
+TEST(Episode, EveryNumericSettingDocumentsTheRangeItChecks) {
+  // The type column ("number in (0, 10]", "integer in [0, 30]") is the
+  // documented range: its bounds are accepted, just beyond them is refused.
+  const sim::Scenario scenario = sim::load_scenario(kOnRay);
+  const auto accepted = [&](const std::string& name, const std::string& value) {
+    try {
+      (void)resolve_episode(scenario, {{name, value}});
+      return true;
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
+  };
+  int checked = 0;
+  for (const SettingDoc& d : episode_settings_table().docs()) {
+    const bool integer = d.type.rfind("integer", 0) == 0;
+    if (!integer && d.type.rfind("number", 0) != 0) continue;
+    if (d.name == "max_iterations") continue;  // "integer >= 0": time_budget bounds the work instead
+    const auto in = d.type.find(" in ");
+    ASSERT_NE(in, std::string::npos) << d.name << ": no documented range in \"" << d.type << "\"";
+    const char open = d.type.at(in + 4);
+    const auto comma = d.type.find(", ", in);
+    const auto close = d.type.find(']', comma);
+    ASSERT_TRUE((open == '(' || open == '[') && comma != std::string::npos && close != std::string::npos) << d.type;
+    const std::string lo = d.type.substr(in + 5, comma - in - 5);
+    const std::string hi = d.type.substr(comma + 2, close - comma - 2);
+    const auto beyond = [&](const std::string& v, double step) {
+      if (integer) return std::to_string(std::stoll(v) + static_cast<long long>(step));
+      const double x = std::stod(v);
+      return format_number(x + step * std::max(1e-3, 1e-3 * std::abs(x)));
+    };
+    EXPECT_TRUE(accepted(d.name, hi)) << d.name << "=" << hi;
+    EXPECT_FALSE(accepted(d.name, beyond(hi, 1))) << d.name << "=" << beyond(hi, 1);
+    EXPECT_EQ(accepted(d.name, lo), open == '[') << d.name << "=" << lo;
+    if (open == '[') {
+      EXPECT_FALSE(accepted(d.name, beyond(lo, -1))) << d.name << "=" << beyond(lo, -1);
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 29);
 }
 
 }  // namespace

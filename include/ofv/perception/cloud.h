@@ -84,7 +84,8 @@ class CloudBuilder {
   std::vector<Accumulator> cells_;
 };
 
-/// \brief Checks that a frame's depth and colour buffers match its intrinsics.
+/// \brief Checks that a frame's depth and colour buffers match its intrinsics,
+///        and that its pose wMc is a finite rigid transform within kMaxLength of the origin.
 /// \throws std::invalid_argument naming the mismatch.
 void check_frame(const RgbdFrame& frame);
 

@@ -36,12 +36,12 @@ SettingsTable<EpisodeSetup> make_table() {
           e.perception = parse_word<PerceptionMode>("perception", v,
                                                     {{"full", PerceptionMode::Full}, {"ground-truth", PerceptionMode::GroundTruth}});
         });
-  t.add({"duration", "number", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
-        [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, 86400.0, true); });
-  t.add({"seed", "integer", std::to_string(d.seed), "",
+  t.add({"duration", "number in (0, 86400]", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
+        [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, kMaxEpisodeDuration, true); });
+  t.add({"seed", "integer in [0, 1000000000]", std::to_string(d.seed), "",
          "the scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement"},
         [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); });
-  t.add({"latency", "integer", std::to_string(d.latency), "frames",
+  t.add({"latency", "integer in [0, 30]", std::to_string(d.latency), "frames",
          "delay between capturing a frame and applying its command (simulation), 0 to 30"},
         [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
@@ -88,6 +88,25 @@ void record_step(StepRecord& rec, const LoopStep& step) {
   for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = step.velocity[i];
 }
 
+// The number of frames of an episode, checked before it becomes an integer
+// (a setup made in code skips the settings' bounds).
+long episode_frames(const EpisodeSetup& setup) {
+  const double rate = setup.scenario.rate;
+  if (!(std::isfinite(rate) && rate > 0.0)) {
+    throw std::invalid_argument("scenario rate must be finite and positive, got " + format_number(rate));
+  }
+  if (!(std::isfinite(setup.duration) && setup.duration >= 0.0 && setup.duration <= kMaxEpisodeDuration)) {
+    throw std::invalid_argument("episode duration must be finite, in [0, " + format_number(kMaxEpisodeDuration) +
+                                "] s, got " + format_number(setup.duration));
+  }
+  const double frames = std::floor(setup.duration * rate + 1e-9) + 1.0;
+  if (!(frames <= kMaxEpisodeFrames)) {
+    throw std::invalid_argument("duration " + format_number(setup.duration) + " s at rate " + format_number(rate) +
+                                " Hz: more than " + format_number(kMaxEpisodeFrames) + " frames");
+  }
+  return static_cast<long>(frames);
+}
+
 }  // namespace
 
 const char* to_string(PerceptionMode mode) { return mode == PerceptionMode::Full ? "full" : "ground-truth"; }
@@ -116,8 +135,8 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
 
 EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observer) {
   const sim::Scenario& scenario = setup.scenario;
+  const long steps = episode_frames(setup);
   const double dt = 1.0 / scenario.rate;
-  const auto steps = static_cast<long>(std::floor(setup.duration * scenario.rate + 1e-9)) + 1;
 
   ViewLoop loop(setup.loop);
   sim::Renderer renderer(scenario);
@@ -180,6 +199,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
   if (setup.robot == RobotKind::Camera) {
     throw std::invalid_argument("a rehearsal needs robot viper850 or afma6 (ViSP's threaded simulators), not camera");
   }
+  (void)episode_frames(setup);
   const EstimatorSettings estimator = setup.loop.estimator.resolve();
   sim::Renderer renderer(setup.scenario);
   std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(setup.scenario.wMc_start), /*real_time=*/true);

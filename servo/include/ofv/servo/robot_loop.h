@@ -47,7 +47,7 @@ struct RobotLoopFrame {
   const RgbdFrame* frame = nullptr;
   const PerceptionResult* perception = nullptr;  ///< nullptr with a problem_source
   const LoopStep* step = nullptr;
-  double dt = 0.0;         ///< period the command is applied for [s]
+  double dt = 0.0;         ///< period the command is applied for [s] (0 with a timestamp that does not increase)
   double frame_age = 0.0;  ///< [s]
   double source_s = 0.0;      ///< time spent waiting for and reading the frame [s]
   double perception_s = 0.0;  ///< compute time of perception [s]
@@ -64,6 +64,11 @@ struct RobotLoopSummary {
  * \brief Runs the loop until the source ends, `max_duration` passes or the
  *        stop flag is raised; then, when it moves the robot, sends a zero
  *        velocity (also when an exception leaves it), so the robot is left at rest.
+ *
+ * A frame older than the stale timeout, a timestamp that does not increase
+ * or is not finite, or a lost object gives a zero velocity for that frame;
+ * the robot is never sent a period that is not finite and >= 0 (0 with
+ * such a stop), and a non-finite timestamp is not the next frame's time base.
  * \throws std::invalid_argument for invalid settings; whatever the source,
  *         perception or robot throw at run time.
  */

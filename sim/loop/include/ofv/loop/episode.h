@@ -84,8 +84,16 @@ struct StepDetail {
 /// \brief Called after every step; may be empty.
 using StepObserver = std::function<void(const StepRecord&, const StepDetail&)>;
 
+/// \brief Longest episode [s] (the setting `duration`: one day).
+inline constexpr double kMaxEpisodeDuration = 86400.0;
+/// \brief Most frames in one episode: kMaxEpisodeDuration at the scenarios' highest rate, 1000 Hz.
+inline constexpr double kMaxEpisodeFrames = 86400.0 * 1000.0;
+
 /// \brief Runs one episode.
-/// \throws std::runtime_error when the loop cannot run (e.g. full perception not built).
+/// \throws std::invalid_argument naming `duration` or `rate` when the episode
+///         is not finite or has more than kMaxEpisodeFrames frames (however
+///         the setup was made); std::runtime_error when the loop cannot run
+///         (e.g. full perception not built).
 [[nodiscard]] EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observer = {});
 
 /**
