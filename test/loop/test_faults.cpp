@@ -511,12 +511,12 @@ TEST(FaultsCli, AMissingDepthImagePrintsTheStopAndFails) {
   EXPECT_EQ(lines.back().v, std::vector<double>(6, 0.0));
 }
 
-TEST(FaultsCli, DryRunLinesAreFlushedAsTheyAreProducedAndSigtermStops) {
-  // Read the first command while the run still goes on, then SIGTERM it.
+// A 30 s dry-run rehearsal started in the background: its pid and the read
+// end of its stdout (stderr goes to /dev/null).
+std::pair<pid_t, int> start_dry_run() {
   int out[2];
-  ASSERT_EQ(pipe(out), 0);
+  if (pipe(out) != 0) return {-1, -1};
   const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
   if (pid == 0) {
     dup2(out[1], STDOUT_FILENO);
     close(out[0]);
@@ -528,7 +528,14 @@ TEST(FaultsCli, DryRunLinesAreFlushedAsTheyAreProducedAndSigtermStops) {
     _exit(127);
   }
   close(out[1]);
-  FILE* in = fdopen(out[0], "r");
+  return {pid, out[0]};
+}
+
+TEST(FaultsCli, DryRunLinesAreFlushedAsTheyAreProducedAndSigtermStops) {
+  // Read the first command while the run still goes on, then SIGTERM it.
+  const auto [pid, out] = start_dry_run();
+  ASSERT_GT(pid, 0);
+  FILE* in = fdopen(out, "r");
   ASSERT_NE(in, nullptr);
   char line[8192];
   ASSERT_NE(std::fgets(line, sizeof line, in), nullptr);
@@ -560,27 +567,14 @@ bool catches_sigterm(pid_t pid) {
 TEST(FaultsCli, SigtermDuringStartUpStillEndsWithTheStop) {
   // As soon as ofv run catches SIGTERM (before it loads the scenario and
   // starts the threaded arm), a SIGTERM ends it with the stop line and exit 0.
-  int out[2];
-  ASSERT_EQ(pipe(out), 0);
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    dup2(out[1], STDOUT_FILENO);
-    close(out[0]);
-    close(out[1]);
-    const int null = open("/dev/null", O_WRONLY);
-    dup2(null, STDERR_FILENO);
-    execl(OFV_BINARY, OFV_BINARY, "run", "--robot", "afma6", "--source", "sim:dvd-one-hand", "--set", "duration=30",
-          "--dry-run", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  close(out[1]);
+  const auto [pid, out] = start_dry_run();
+  ASSERT_GT(pid, 0);
   const auto start = std::chrono::steady_clock::now();
   while (!catches_sigterm(pid) && std::chrono::steady_clock::now() - start < std::chrono::seconds(20)) {
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
   kill(pid, SIGTERM);
-  FILE* in = fdopen(out[0], "r");
+  FILE* in = fdopen(out, "r");
   ASSERT_NE(in, nullptr);
   std::string text;
   char buffer[4096];
