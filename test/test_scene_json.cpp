@@ -123,6 +123,22 @@ TEST(SceneJson, BadInputNamesFieldAndValue) {
   }
 }
 
+TEST(SceneJson, TextIsCheckedAsAFileIs) {
+  EXPECT_EQ(scene_from_text(kMinimal, "text.json").problem.positions.cols(), 1);
+  const auto message = [](const std::string& text) {
+    try {
+      (void)scene_from_text(text, "text.json");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(R"({"supervoxels": [], "supervoxels": []})").find("text.json: invalid JSON: duplicate key"),
+            std::string::npos);
+  EXPECT_NE(message(std::string(40, '[') + std::string(40, ']')).find("nested deeper than"), std::string::npos);
+  EXPECT_NE(message("{").find("text.json: invalid JSON"), std::string::npos);
+}
+
 TEST(SceneJson, SetParamParsesEachType) {
   EstimatorParams p;
   set_param(p, "preset", "authors_code");

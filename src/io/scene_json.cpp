@@ -10,8 +10,10 @@
 #include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <stdexcept>
 #include <vector>
@@ -243,6 +245,15 @@ Scene read_scene(const std::string& path) {
     throw std::invalid_argument(path + ": " + std::to_string(bytes) + " bytes, more than " +
                                 std::to_string(kMaxSceneBytes));
   }
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return scene_from_text(text, path);
+}
+
+Scene scene_from_text(const std::string& text, const std::string& source) {
+  if (text.size() > kMaxSceneBytes) {
+    throw std::invalid_argument(source + ": " + std::to_string(text.size()) + " bytes, more than " +
+                                std::to_string(kMaxSceneBytes));
+  }
   // The parser's callback sees every value as it is read: nesting deeper than
   // kMaxSceneDepth and a key repeated in one object stop the parse there.
   std::vector<std::set<std::string>> keys;  // of the objects being read
@@ -264,13 +275,13 @@ Scene read_scene(const std::string& path) {
   };
   json j;
   try {
-    j = json::parse(in, check);
+    j = json::parse(text, check);
   } catch (const json::exception& e) {  // syntax errors and number overflow (1e999)
-    throw std::invalid_argument(path + ": invalid JSON: " + clip(e.what()));
+    throw std::invalid_argument(source + ": invalid JSON: " + clip(e.what()));
   } catch (const std::invalid_argument&) {
-    throw std::invalid_argument(path + ": invalid JSON: " + problem);
+    throw std::invalid_argument(source + ": invalid JSON: " + problem);
   }
-  return scene_from_json(j, path);
+  return scene_from_json(j, source);
 }
 
 void set_param(EstimatorParams& params, const std::string& name, const std::string& value) {

@@ -113,14 +113,18 @@ std::uint64_t bytes_per_pixel(std::uint64_t format) {
 }  // namespace
 
 void check_oni_file(const std::string& path) {
-  const std::function<void(std::uint64_t, const std::string&)> fail = [&](std::uint64_t offset,
-                                                                           const std::string& what) {
-    throw std::invalid_argument(path + ": offset " + std::to_string(offset) + ": " + what);
-  };
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   if (!in || ec) throw std::invalid_argument(path + ": cannot read the .oni file");
+  check_oni_file(in, size, path);
+}
+
+void check_oni_file(std::istream& in, std::uint64_t size, const std::string& path) {
+  const std::function<void(std::uint64_t, const std::string&)> fail = [&](std::uint64_t offset,
+                                                                           const std::string& what) {
+    throw std::invalid_argument(path + ": offset " + std::to_string(offset) + ": " + what);
+  };
   const auto read = [&](std::uint64_t offset, std::uint64_t n) {
     std::vector<std::uint8_t> bytes(n);
     in.seekg(static_cast<std::streamoff>(offset));

@@ -10,12 +10,7 @@
 
 namespace ofv {
 
-void for_each_data_line(const std::string& path, const std::string& what,
-                        const std::function<void(const std::string&, int)>& f) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open the " + what);
-  }
+void for_each_data_line(std::istream& in, const std::function<void(const std::string&, int)>& f) {
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
@@ -27,9 +22,18 @@ void for_each_data_line(const std::string& path, const std::string& what,
   }
 }
 
-std::vector<StampedPose> read_pose_file(const std::string& path) {
+void for_each_data_line(const std::string& path, const std::string& what,
+                        const std::function<void(const std::string&, int)>& f) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot open the " + what);
+  }
+  for_each_data_line(in, f);
+}
+
+std::vector<StampedPose> parse_pose_file(std::istream& in, const std::string& path) {
   std::vector<StampedPose> poses;
-  for_each_data_line(path, "pose file", [&](const std::string& line, int number) {
+  for_each_data_line(in, [&](const std::string& line, int number) {
     std::istringstream fields(line);
     double t = 0, tx = 0, ty = 0, tz = 0, qx = 0, qy = 0, qz = 0, qw = 0;
     if (!(fields >> t >> tx >> ty >> tz >> qx >> qy >> qz >> qw)) {
@@ -55,6 +59,29 @@ std::vector<StampedPose> read_pose_file(const std::string& path) {
   std::stable_sort(poses.begin(), poses.end(),
                    [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; });
   return poses;
+}
+
+std::vector<StampedPose> read_pose_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot open the pose file");
+  }
+  return parse_pose_file(in, path);
+}
+
+std::vector<TimedFile> parse_timestamp_list(std::istream& in, const std::string& path) {
+  std::vector<TimedFile> out;
+  for_each_data_line(in, [&](const std::string& line, int number) {
+    std::istringstream fields(line);
+    TimedFile e{};
+    if (!(fields >> e.time >> e.file) || !std::isfinite(e.time)) {
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": expected 'timestamp filename', got '" +
+                               line + "'");
+    }
+    out.push_back(e);
+  });
+  std::stable_sort(out.begin(), out.end(), [](const TimedFile& a, const TimedFile& b) { return a.time < b.time; });
+  return out;
 }
 
 std::string format_pose_line(double time, const Eigen::Isometry3d& wMc) {
@@ -90,9 +117,9 @@ Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double
   return out;
 }
 
-CameraIntrinsics read_intrinsics_file(const std::string& path) {
+CameraIntrinsics parse_intrinsics_file(std::istream& in, const std::string& path) {
   std::optional<CameraIntrinsics> found;
-  for_each_data_line(path, "intrinsics file", [&](const std::string& line, int) {
+  for_each_data_line(in, [&](const std::string& line, int) {
     if (found) {
       return;
     }
@@ -110,6 +137,14 @@ CameraIntrinsics read_intrinsics_file(const std::string& path) {
     throw std::runtime_error(path + ": no 'width height fx fy cx cy' line");
   }
   return *found;
+}
+
+CameraIntrinsics read_intrinsics_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot open the intrinsics file");
+  }
+  return parse_intrinsics_file(in, path);
 }
 
 void write_intrinsics_file(const std::string& path, const CameraIntrinsics& k) {

@@ -25,26 +25,14 @@ namespace ofv {
 
 namespace {
 
-struct ListEntry {
-  double time;
-  std::string file;
-};
+using ListEntry = TimedFile;
 
 std::vector<ListEntry> read_list(const std::string& path) {
-  std::vector<ListEntry> out;
-  for_each_data_line(
-      path, "list (not a TUM RGB-D sequence?)", [&](const std::string& line, int number) {
-        std::istringstream fields(line);
-        ListEntry e{};
-        if (!(fields >> e.time >> e.file) || !std::isfinite(e.time)) {
-          throw std::runtime_error(path + ":" + std::to_string(number) +
-                                   ": expected 'timestamp filename', got '" + line + "'");
-        }
-        out.push_back(e);
-      });
-  std::stable_sort(out.begin(), out.end(),
-                   [](const ListEntry& a, const ListEntry& b) { return a.time < b.time; });
-  return out;
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot open the list (not a TUM RGB-D sequence?)");
+  }
+  return parse_timestamp_list(in, path);
 }
 
 /// A PNG file whose header has been read and checked, ready to decode.

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -135,6 +136,62 @@ TEST(TumSequence, BrokenInputsAreErrorsNamingThePath) {
   std::ofstream(dir / "groundtruth.txt") << "0.0 1 2 3 0 0 0 2\n";
   const std::string norm = message([&] { TumSequenceSource s(dir.string()); });
   EXPECT_NE(norm.find("groundtruth.txt:1: quaternion norm 2"), std::string::npos) << norm;
+}
+
+TEST(SequenceFiles, TextIsParsedAsTheFileIs) {
+  const std::string poses = "# t tx ty tz qx qy qz qw\n0.2 1 2 3 0 0 0 1\n\n0.1 4 5 6 0 0 1 0\n";
+  const fs::path file = scratch("pose_text.txt");
+  std::ofstream(file) << poses;
+  std::istringstream in(poses);
+  const auto parsed = parse_pose_file(in, "text");
+  const auto read = read_pose_file(file.string());
+  ASSERT_EQ(parsed.size(), 2u);
+  ASSERT_EQ(read.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(parsed[k].time, read[k].time);
+    EXPECT_TRUE(parsed[k].wMc.isApprox(read[k].wMc, 0.0));
+  }
+  EXPECT_EQ(parsed[0].time, 0.1);  // sorted by time
+  std::istringstream bad_pose("0.1 1 2 3 0 0 0\n");
+  EXPECT_THROW((void)parse_pose_file(bad_pose, "text"), std::runtime_error);
+
+  std::istringstream intrinsics("# w h fx fy cx cy\n16 12 15 15 7.5 5.5\n");
+  EXPECT_EQ(parse_intrinsics_file(intrinsics, "text").height, 12);
+  std::istringstream too_wide("5000 12 15 15 7.5 5.5\n");
+  EXPECT_THROW((void)parse_intrinsics_file(too_wide, "text"), std::runtime_error);
+
+  std::istringstream list("# timestamp filename\n2 depth/2.png\n1 depth/1.png\n");
+  const auto files = parse_timestamp_list(list, "depth.txt");
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].file, "depth/1.png");
+  std::istringstream bad_list("nan depth/1.png\n");
+  try {
+    (void)parse_timestamp_list(bad_list, "depth.txt");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("depth.txt:1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PcdSequence, HeaderIsCheckedInMemoryAsInTheFile) {
+  const std::string header =
+      "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+      "WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA binary\n";
+  const std::string whole = header + std::string(32, '\0');
+  std::istringstream good(whole);
+  EXPECT_NO_THROW(check_pcd_header(good, whole.size(), "mem.pcd"));
+  const fs::path file = scratch("header.pcd");
+  std::ofstream(file, std::ios::binary) << whole;
+  EXPECT_NO_THROW(check_pcd_header(file.string()));
+  // One point short of the header's two: refused, naming the source.
+  const std::string cut = header + std::string(31, '\0');
+  std::istringstream short_data(cut);
+  try {
+    check_pcd_header(short_data, cut.size(), "mem.pcd");
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mem.pcd: invalid PCD header: DATA binary"), std::string::npos) << e.what();
+  }
 }
 
 TEST(PcdSequence, WritesAndReadsBackFramesAndFitsIntrinsics) {

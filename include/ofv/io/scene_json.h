@@ -41,6 +41,10 @@ constexpr int kMaxSceneDepth = 32;
 /// characters of it.
 [[nodiscard]] Scene read_scene(const std::string& path);
 
+/// \brief Parses a scene file's text, as read_scene() does; `source` names it in errors.
+/// \throws std::invalid_argument as read_scene().
+[[nodiscard]] Scene scene_from_text(const std::string& text, const std::string& source);
+
 /// \brief Writes a scene as JSON (only the parameters that were given).
 [[nodiscard]] nlohmann::ordered_json scene_to_json(const Scene& scene);
 

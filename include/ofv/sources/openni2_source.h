@@ -15,7 +15,9 @@
 #include "ofv/frame_source.h"
 #include "ofv/sources/sequence_files.h"
 
+#include <cstdint>
 #include <fstream>
+#include <istream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -53,6 +55,8 @@ struct OpenNi2Options {
  * \throws std::invalid_argument "PATH: offset N: what" at the first problem.
  */
 void check_oni_file(const std::string& path);
+/// \brief check_oni_file() on a file already open, of `size` bytes; `path` names it in errors.
+void check_oni_file(std::istream& in, std::uint64_t size, const std::string& path);
 
 /**
  * \brief Frames from an OpenNI2 device (URI, e.g. a PrimeSense device URI,

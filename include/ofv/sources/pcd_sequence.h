@@ -20,6 +20,7 @@
 #include "ofv/sources/sequence_files.h"
 
 #include <cstdint>
+#include <istream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +29,21 @@ namespace ofv {
 
 /// \brief Largest number of points of one PCD frame (kMaxImageSide squared).
 constexpr std::uint64_t kMaxPcdPoints = std::uint64_t{kMaxImageSide} * kMaxImageSide;
+
+/**
+ * \brief Checks what PCL would trust in a PCD header (PCL maps binary data
+ *        without checking it against the file size, and crashes on empty or
+ *        garbage files): every header line present, the per-field lists
+ *        consistent, x, y, z as 4-byte floats and a 4-byte rgb or rgba,
+ *        POINTS = WIDTH * HEIGHT <= kMaxPcdPoints, and for binary data the
+ *        points inside the file.
+ * \throws std::invalid_argument "PATH: invalid PCD header: what" (or "PATH:
+ *         cannot open the PCD file").
+ */
+void check_pcd_header(const std::string& path);
+/// \brief check_pcd_header() on a file already open at its start, of `file_size` bytes;
+///        `path` names it in errors.
+void check_pcd_header(std::istream& in, std::uint64_t file_size, const std::string& path);
 
 /// \brief Reads a PCD sequence frame by frame (see the file comment for the layout).
 class PcdSequenceSource : public FrameSource {

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <functional>
+#include <istream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,13 +21,15 @@ namespace ofv {
 constexpr int kMaxImageSide = 4096;
 
 /**
- * rief Calls `f(line, number)` for each data line of a sequence text file:
+ * \brief Calls `f(line, number)` for each data line of a sequence text file:
  *        blank lines and `#` comments are skipped; numbers count from 1.
- * 	hrows std::runtime_error "PATH: cannot open the WHAT" when unreadable,
+ * \throws std::runtime_error "PATH: cannot open the WHAT" when unreadable,
  *         and whatever `f` throws.
  */
 void for_each_data_line(const std::string& path, const std::string& what,
                         const std::function<void(const std::string&, int)>& f);
+/// \brief for_each_data_line() on text already open (the file versions' parsers, fuzzed).
+void for_each_data_line(std::istream& in, const std::function<void(const std::string&, int)>& f);
 
 /// \brief A timestamped camera pose wMc (camera -> world), ViSP camera axes.
 struct StampedPose {
@@ -44,6 +47,22 @@ constexpr double kQuaternionTolerance = 1e-3;
  * \throws std::runtime_error naming the file and line when it cannot be read or parsed.
  */
 [[nodiscard]] std::vector<StampedPose> read_pose_file(const std::string& path);
+/// \brief read_pose_file() on text already open; `path` names it in errors.
+[[nodiscard]] std::vector<StampedPose> parse_pose_file(std::istream& in, const std::string& path);
+
+/// \brief One line of a TUM RGB-D image list (`rgb.txt`, `depth.txt`).
+struct TimedFile {
+  double time = 0.0;  ///< [s]
+  std::string file;   ///< relative to the sequence folder
+};
+
+/**
+ * \brief Parses a TUM RGB-D image list: `timestamp filename` per line, `#`
+ *        comments; sorted by time (stable). `path` names it in errors.
+ * \throws std::runtime_error naming the file and line when a line cannot be parsed
+ *         or its timestamp is not finite.
+ */
+[[nodiscard]] std::vector<TimedFile> parse_timestamp_list(std::istream& in, const std::string& path);
 
 /// \brief Appends one pose line to a TUM pose file stream's text.
 [[nodiscard]] std::string format_pose_line(double time, const Eigen::Isometry3d& wMc);
@@ -62,6 +81,8 @@ constexpr double kQuaternionTolerance = 1e-3;
  * \throws std::runtime_error naming the file when it cannot be read or parsed.
  */
 [[nodiscard]] CameraIntrinsics read_intrinsics_file(const std::string& path);
+/// \brief read_intrinsics_file() on text already open; `path` names it in errors.
+[[nodiscard]] CameraIntrinsics parse_intrinsics_file(std::istream& in, const std::string& path);
 
 /// \brief Writes what read_intrinsics_file() reads.
 /// \throws std::runtime_error naming the file when it cannot be written.
