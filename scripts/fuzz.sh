@@ -36,9 +36,17 @@ command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (scripts/ins
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 build_start=$SECONDS
-cmake -S . -B "$build" -DOFV_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DBUILD_SHARED_LIBS=OFF -DOFV_BUILD_TESTS=OFF -DOFV_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
-cmake --build "$build" -j "${OFV_JOBS:-2}" --target "${targets[@]}" >/dev/null
+for t in "${targets[@]}"; do
+  [ -d "fuzz/corpus/$t" ] || { echo "fuzz.sh: unknown target $t (expected: ${all_targets[*]})" >&2; exit 2; }
+done
+mkdir -p "$build"
+if ! { cmake -S . -B "$build" -DOFV_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+         -DBUILD_SHARED_LIBS=OFF -DOFV_BUILD_TESTS=OFF -DOFV_BUILD_BENCH=OFF "${launcher[@]}" &&
+       cmake --build "$build" -j "${OFV_JOBS:-2}" --target "${targets[@]}"; } >"$build/build.log" 2>&1; then
+  tail -n 30 "$build/build.log" >&2
+  echo "fuzz.sh: the fuzz build failed (log: $build/build.log)" >&2
+  exit 2
+fi
 echo "fuzz build: $((SECONDS - build_start)) s"
 
 # One target: its own corpus copy (seeds + what earlier runs found), its
@@ -48,7 +56,8 @@ run_target() {
   local corpus="$build/corpus/$t" findings="$build/findings/$t" log="$build/logs/$t.log"
   mkdir -p "$corpus" "$findings" "$(dirname "$log")"
   cp -n "$root/fuzz/corpus/$t"/* "$corpus"/ 2>/dev/null || true
-  local start=$SECONDS status=0
+  local start=$SECONDS status=0 before
+  before=$(find "$findings" -type f | wc -l)  # findings of earlier runs stay, and do not count
   # -timeout: one input taking 10 s is a hang; -rss_limit_mb: 2 GB is a finding.
   # ASan's leak check runs after each input that allocated more than it freed.
   # Run in the findings folder: files a scenario names are looked up there (none exist).
@@ -57,12 +66,12 @@ run_target() {
      -artifact_prefix="$findings/" "$corpus" >"$log" 2>&1) || status=$?
   local runs found
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  found=$(find "$findings" -type f | wc -l)
+  found=$(( $(find "$findings" -type f | wc -l) - before ))
   if [ "$status" -eq 0 ] && [ "$found" -eq 0 ]; then
     printf '%-20s %10s executions %5d s  nothing found\n' "$t" "${runs:-?}" $((SECONDS - start))
   else
     printf '%-20s %10s executions %5d s  FOUND (exit %d): %s (log %s)\n' "$t" "${runs:-?}" $((SECONDS - start)) \
-      "$status" "$(find "$findings" -type f | tr '\n' ' ')" "$log"
+      "$status" "$(ls -t "$findings" | head -n "$found" | tr '\n' ' ')" "$log"
     return 1
   fi
 }
