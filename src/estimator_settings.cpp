@@ -31,9 +31,8 @@ void validate(const EstimatorSettings& s) {
   require_positive("clearance", s.clearance);
   require_positive("push_radius", s.push_radius);
   require_positive("step", s.step);
-  if (s.max_iterations < 0) {
-    usage_error("parameter 'max_iterations' must be a non-negative integer, got " +
-                std::to_string(s.max_iterations));
+  if (s.max_iterations < 0 || s.max_iterations > kMaxIterations) {
+    usage_error("parameter 'max_iterations' must be an integer in [0, 100000000], got " + std::to_string(s.max_iterations));
   }
   if (!(s.time_budget > 0.0 && s.time_budget <= 3600.0)) {
     usage_error("parameter 'time_budget' must be in (0, 3600] s, got " + format_value(s.time_budget));
@@ -159,9 +158,9 @@ SettingsTable<EstimatorParams> make_table() {
   t.add({"step", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.step), "m",
          "length of one push on the tangent plane (paper: r_seed)"},
         [](P& p, const std::string& v) { p.step = length(p, "step", v); });
-  t.add({"max_iterations", "integer >= 0", std::to_string(d.max_iterations), "",
+  t.add({"max_iterations", "integer in [0, 100000000]", std::to_string(d.max_iterations), "",
          "push steps before giving up with the best visited view"},
-        [](P& p, const std::string& v) { p.max_iterations = static_cast<int>(parse_integer("max_iterations", v, 0, INT_MAX)); });
+        [](P& p, const std::string& v) { p.max_iterations = static_cast<int>(parse_integer("max_iterations", v, 0, kMaxIterations)); });
   t.add({"warm_start", "bool", format_bool(d.warm_start), "", "start from the previous frame's view instead of t0"},
         [](P& p, const std::string& v) { p.warm_start = parse_bool("warm_start", v); });
   t.add({"time_budget", "number in (0, 3600]", format_number(d.time_budget), "s",

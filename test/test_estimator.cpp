@@ -324,6 +324,9 @@ TEST(Estimator, InvalidSettingsNameTheParameter) {
   s = {};
   s.time_budget = 0.0;
   EXPECT_NE(message_for(s).find("time_budget"), std::string::npos);
+  s = {};
+  s.max_iterations = kMaxIterations + 1;
+  EXPECT_NE(message_for(s).find("max_iterations"), std::string::npos);
 }
 
 TEST(Estimator, ExtremeCoordinatesAndHugeProblemsAreRefused) {
@@ -357,7 +360,7 @@ TEST(Estimator, TheTimeBudgetEndsTheIterationWithTheBestIterate) {
   EstimatorSettings s;
   s.clearance = 0.1;
   s.step = 1e-9;
-  s.max_iterations = std::numeric_limits<int>::max();
+  s.max_iterations = kMaxIterations;
   s.time_budget = 0.05;
   const ViewEstimate e = estimate_view(p, s);
   EXPECT_EQ(e.status, ViewStatus::OutOfTime);

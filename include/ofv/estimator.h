@@ -90,6 +90,8 @@ inline constexpr double kMaxLength = 1e4;
 /// More occlusion rays (usable supervoxels x occluders, spec §3) than this
 /// are refused (24 bytes each: 240 MB): thin the supervoxels or occluders.
 inline constexpr double kMaxOcclusionRays = 1e7;
+/// Most push steps max_iterations may ask for (time_budget bounds the work too).
+inline constexpr int kMaxIterations = 100000000;
 /// \brief true for the statuses whose t_f is free of occlusion (converged, no occluders).
 [[nodiscard]] inline bool is_free(ViewStatus s) { return s == ViewStatus::Converged || s == ViewStatus::NoOccluders; }
 
@@ -119,7 +121,7 @@ struct EstimatorParams {
 
 /// \brief Throws std::invalid_argument, naming the parameter and its value,
 /// unless every length is finite, positive and at most kMaxLength,
-/// max_iterations >= 0 and time_budget in (0, 3600] s.
+/// max_iterations in [0, kMaxIterations] and time_budget in (0, 3600] s.
 void validate(const EstimatorSettings& settings);
 
 /**
