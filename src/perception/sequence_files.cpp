@@ -10,6 +10,13 @@
 
 namespace ofv {
 
+namespace {
+// A line of the file as an error message quotes it: at most 80 characters.
+std::string quoted(const std::string& line) {
+  return "'" + (line.size() > 80 ? line.substr(0, 80) + "..." : line) + "'";
+}
+}  // namespace
+
 void for_each_data_line(std::istream& in, const std::function<void(const std::string&, int)>& f) {
   std::string line;
   int number = 0;
@@ -38,12 +45,11 @@ std::vector<StampedPose> parse_pose_file(std::istream& in, const std::string& pa
     double t = 0, tx = 0, ty = 0, tz = 0, qx = 0, qy = 0, qz = 0, qw = 0;
     if (!(fields >> t >> tx >> ty >> tz >> qx >> qy >> qz >> qw)) {
       throw std::runtime_error(path + ":" + std::to_string(number) +
-                               ": expected 't tx ty tz qx qy qz qw', got '" + line + "'");
+                               ": expected 't tx ty tz qx qy qz qw', got " + quoted(line));
     }
     const Eigen::Quaterniond q(qw, qx, qy, qz);
     if (!std::isfinite(tx + ty + tz + t)) {
-      throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose '" + line +
-                               "'");
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": invalid pose " + quoted(line));
     }
     if (!(std::abs(q.norm() - 1.0) <= kQuaternionTolerance)) {
       throw std::runtime_error(path + ":" + std::to_string(number) + ": quaternion norm " +
@@ -75,8 +81,8 @@ std::vector<TimedFile> parse_timestamp_list(std::istream& in, const std::string&
     std::istringstream fields(line);
     TimedFile e{};
     if (!(fields >> e.time >> e.file) || !std::isfinite(e.time)) {
-      throw std::runtime_error(path + ":" + std::to_string(number) + ": expected 'timestamp filename', got '" +
-                               line + "'");
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": expected 'timestamp filename', got " +
+                               quoted(line));
     }
     out.push_back(e);
   });
@@ -129,7 +135,7 @@ CameraIntrinsics parse_intrinsics_file(std::istream& in, const std::string& path
         k.height <= 0 || k.width > kMaxImageSide || k.height > kMaxImageSide || !std::isfinite(k.cx) || !std::isfinite(k.cy) ||
         !std::isfinite(k.fx) || !std::isfinite(k.fy) || !(k.fx > 0.0) || !(k.fy > 0.0)) {
       throw std::runtime_error(path + ": expected 'width height fx fy cx cy' (sizes 1 to " +
-                               std::to_string(kMaxImageSide) + ", focal lengths > 0), got '" + line + "'");
+                               std::to_string(kMaxImageSide) + ", focal lengths > 0), got " + quoted(line));
     }
     found = k;
   });

@@ -171,6 +171,15 @@ TEST(SequenceFiles, TextIsParsedAsTheFileIs) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("depth.txt:1"), std::string::npos) << e.what();
   }
+  // A long bad line is quoted shortened, so that the error stays one short line.
+  std::istringstream long_line("0.1 " + std::string(100000, '7') + "\n");
+  try {
+    (void)parse_pose_file(long_line, "poses.txt");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_LT(std::string(e.what()).size(), 200U);
+    EXPECT_NE(std::string(e.what()).find("poses.txt:1"), std::string::npos) << e.what();
+  }
 }
 
 TEST(PcdSequence, HeaderIsCheckedInMemoryAsInTheFile) {
