@@ -77,8 +77,11 @@ class Png {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& why) const {
-    throw std::invalid_argument(path_ + ": " + what_ + ": " + why);
+  // Frees libpng's state first: a constructor that throws runs no destructor.
+  [[noreturn]] void fail(const std::string& why) {
+    const std::string message = path_ + ": " + what_ + ": " + why;
+    png_image_free(&image_);
+    throw std::invalid_argument(message);
   }
   std::string path_;
   const char* what_;
