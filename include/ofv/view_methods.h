@@ -99,8 +99,8 @@ struct NoFreeViewSettings {
   /// object. When the camera has moved away from it and shows this fraction
   /// of that less, and the frame's occluders (score_view) do not make that
   /// position worse than the current one, the camera goes back there and
-  /// holds until, back there, it shows this fraction less again (the scene
-  /// changed). A target that only a partial perception believes clear (an
+  /// holds until t0 is clear again or, back there, it shows this fraction
+  /// less for 16 frames in a row (the scene changed). A target that only a partial perception believes clear (an
   /// occluder hidden behind another) so cannot lead the camera into a cage
   /// that hides the object. 0 = off.
   double retreat_drop = 0.1;

@@ -225,11 +225,12 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   if (s.retreat_drop <= 0.0) return target;
   constexpr double kAway = 0.01;  // [m]: the camera has moved from a view
   constexpr int kFrames = 2;      // a loss counts when it lasts this many frames (one frame is noise)
+  constexpr int kReleaseFrames = 16;  // back at the held view, this many frames showing less release it
   const double keep = 1.0 - s.retreat_drop;
   if (held_) {
     const bool there = (here - held_->position).norm() <= kAway;
     low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
-    if (estimate.iterations > 0 && low_frames_ < kFrames * 8) return held_->position;
+    if (estimate.iterations > 0 && low_frames_ < kReleaseFrames) return held_->position;
     held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
     best_seen_ = SeenView{here, shown};
     low_frames_ = 0;
