@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <optional>
 #include <stdexcept>
@@ -28,17 +29,46 @@ int find_root(std::vector<int>& parent, int i) {
   return i;
 }
 
-std::int64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
-  // 21 bits a coordinate: cells of a few centimetres cover kilometres.
-  constexpr std::int64_t mask = (std::int64_t{1} << 21) - 1;
-  return ((x & mask) << 42) | ((y & mask) << 21) | (z & mask);
-}
+using Cell = std::array<std::int64_t, 3>;
+
+struct CellHash {
+  std::size_t operator()(const Cell& c) const noexcept {
+    return std::hash<std::int64_t>{}((c[0] * 73856093) ^ (c[1] * 19349663) ^ (c[2] * 83492791));
+  }
+};
 
 void require(bool ok, const char* name, double value, const char* what) {
   if (!ok) {
     throw std::invalid_argument(std::string("tracker setting '") + name + "' must be " + what + ", got " +
                                 format_number(value));
   }
+}
+
+// Nearest of `points` to `q`: the smallest index of those at the least
+// squared distance, as a scan of every point finds it, from a search that
+// looks only at the points whose x is within that distance (`by_x`: the
+// indices of `points` sorted by x). Returns the squared distance.
+double nearest_by_x(const Eigen::Matrix3Xd& points, const std::vector<Eigen::Index>& by_x, const Eigen::Vector3d& q,
+                    Eigen::Index& nearest) {
+  double best = std::numeric_limits<double>::infinity();
+  nearest = 0;
+  const auto first_right = std::lower_bound(by_x.begin(), by_x.end(), q.x(),
+                                            [&](Eigen::Index i, double x) { return points(0, i) < x; });
+  const auto consider = [&](Eigen::Index i) {
+    const double dx = points(0, i) - q.x();
+    if (dx * dx > best) return false;  // so is every point further along x
+    const double d2 = (points.col(i) - q).squaredNorm();
+    if (d2 < best || (d2 == best && i < nearest)) {
+      best = d2;
+      nearest = i;
+    }
+    return true;
+  };
+  for (auto it = first_right; it != by_x.end() && consider(*it); ++it) {
+  }
+  for (auto it = first_right; it != by_x.begin() && consider(*(it - 1)); --it) {
+  }
+  return best;
 }
 
 // Translation taking `before` onto the points `cluster` of `after`: a few
@@ -53,6 +83,9 @@ std::optional<Eigen::Vector3d> register_translation(const Eigen::Matrix3Xd& befo
                                                     double trim) {
   const std::size_t stride = std::max<std::size_t>(1, cluster.size() / 256);
   const double trim2 = trim * trim;
+  std::vector<Eigen::Index> by_x(static_cast<std::size_t>(before.cols()));
+  std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
+  std::sort(by_x.begin(), by_x.end(), [&](Eigen::Index i, Eigen::Index j) { return before(0, i) < before(0, j); });
   Eigen::Vector3d d = guess;
   std::array<std::vector<double>, 3> residuals;
   for (int iteration = 0; iteration < 8; ++iteration) {
@@ -61,7 +94,7 @@ std::optional<Eigen::Vector3d> register_translation(const Eigen::Matrix3Xd& befo
     for (std::size_t k = 0; k < cluster.size(); k += stride, ++tried) {
       const Eigen::Vector3d q = after.col(cluster[k]) - d;
       Eigen::Index nearest = 0;
-      const double best = (before.colwise() - q).colwise().squaredNorm().minCoeff(&nearest);
+      const double best = nearest_by_x(before, by_x, q, nearest);
       if (best >= trim2) continue;
       for (std::size_t a = 0; a < 3; ++a) residuals[a].push_back(q(static_cast<Eigen::Index>(a)) - before(static_cast<Eigen::Index>(a), nearest));
     }
@@ -103,37 +136,109 @@ std::vector<std::vector<int>> cluster_points(const Eigen::Matrix3Xd& points, dou
   const int n = static_cast<int>(points.cols());
   std::vector<int> parent(static_cast<std::size_t>(n));
   std::iota(parent.begin(), parent.end(), 0);
-  // Hash grid of cell edge link_distance: linked points are in neighbouring cells.
-  std::unordered_map<std::int64_t, std::vector<int>> grid;
-  std::vector<std::array<std::int64_t, 3>> cell(static_cast<std::size_t>(n));
-  std::vector<char> finite(static_cast<std::size_t>(n), 0);
+  const auto unite = [&](int i, int j) {
+    const int ri = find_root(parent, i);
+    const int rj = find_root(parent, j);
+    if (ri != rj) parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
+  };
+  // Grid of cell edge link_distance / 2. Two points of one cell are
+  // closer than link_distance (the cell's diagonal is 0.87 of it), so a cell
+  // is linked whole; linked points are at most two cells apart along each
+  // axis, and two cells need one linked pair, looked for only while they
+  // are not yet in one cluster. The clusters are those of linking every
+  // pair closer than link_distance. Points too far out for a cell index
+  // (2^52 edges) are compared with every point.
+  const double edge = 0.5 * link_distance;
+  const double link2 = link_distance * link_distance;
+  const auto close = [&](int i, int j) { return (points.col(i) - points.col(j)).squaredNorm() < link2; };
+  std::vector<Cell> cell_of(static_cast<std::size_t>(n));
+  std::vector<int> far;
+  std::vector<char> finite(static_cast<std::size_t>(n), 0);  // 1: finite, 2: finite and in a cell
+  Cell low{}, high{};
+  bool any = false;
   for (int i = 0; i < n; ++i) {
     if (!points.col(i).allFinite()) continue;
     finite[static_cast<std::size_t>(i)] = 1;
-    for (int a = 0; a < 3; ++a) {
-      cell[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] =
-          static_cast<std::int64_t>(std::floor(points(a, i) / link_distance));
+    const Eigen::Vector3d index = (points.col(i) / edge).array().floor();
+    if (!(index.cwiseAbs().maxCoeff() < 0x1p52)) {
+      far.push_back(i);
+      continue;
     }
-    const auto& c = cell[static_cast<std::size_t>(i)];
-    grid[cell_key(c[0], c[1], c[2])].push_back(i);
+    finite[static_cast<std::size_t>(i)] = 2;
+    Cell& c = cell_of[static_cast<std::size_t>(i)];
+    for (std::size_t a = 0; a < 3; ++a) {
+      c[a] = static_cast<std::int64_t>(index(static_cast<Eigen::Index>(a)));
+      low[a] = any ? std::min(low[a], c[a]) : c[a];
+      high[a] = any ? std::max(high[a], c[a]) : c[a];
+    }
+    any = true;
   }
-  const double link2 = link_distance * link_distance;
+  // Cell ids in order of their first point: a dense table over the points'
+  // box (padded by the two neighbouring cells) where it is small, a hash
+  // map otherwise.
+  constexpr std::int64_t kDenseCells = std::int64_t{1} << 22;
+  std::array<std::int64_t, 3> size{};
+  std::int64_t volume = 1;
+  for (std::size_t a = 0; a < 3 && any; ++a) {
+    size[a] = high[a] - low[a] + 5;
+    volume = size[a] > kDenseCells ? kDenseCells + 1 : std::min(kDenseCells + 1, volume * size[a]);
+  }
+  const bool dense = any && volume <= kDenseCells;
+  std::vector<int> dense_id(dense ? static_cast<std::size_t>(volume) : 0, -1);
+  std::unordered_map<Cell, int, CellHash> hashed_id;
+  const auto slot = [&](const Cell& c) -> int* {
+    if (!dense) {
+      const auto it = hashed_id.find(c);
+      return it == hashed_id.end() ? nullptr : &it->second;
+    }
+    std::int64_t k = 0;
+    for (std::size_t a = 0; a < 3; ++a) k = k * size[a] + (c[a] - low[a] + 2);
+    return &dense_id[static_cast<std::size_t>(k)];
+  };
+  std::vector<Cell> cells;
+  std::vector<std::vector<int>> members;
   for (int i = 0; i < n; ++i) {
-    if (!finite[static_cast<std::size_t>(i)]) continue;
-    const auto& c = cell[static_cast<std::size_t>(i)];
-    for (std::int64_t dx = -1; dx <= 1; ++dx) {
-      for (std::int64_t dy = -1; dy <= 1; ++dy) {
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          const auto it = grid.find(cell_key(c[0] + dx, c[1] + dy, c[2] + dz));
-          if (it == grid.end()) continue;
-          for (const int j : it->second) {
-            if (j <= i || (points.col(i) - points.col(j)).squaredNorm() >= link2) continue;
-            const int ri = find_root(parent, i);
-            const int rj = find_root(parent, j);
-            if (ri != rj) parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
-          }
+    if (finite[static_cast<std::size_t>(i)] != 2) continue;  // not finite, or far
+    const Cell& c = cell_of[static_cast<std::size_t>(i)];
+    int* id = slot(c);
+    if (id == nullptr) id = &hashed_id.emplace(c, -1).first->second;
+    if (*id < 0) {
+      *id = static_cast<int>(cells.size());
+      cells.push_back(c);
+      members.emplace_back();
+    } else {
+      unite(members[static_cast<std::size_t>(*id)].front(), i);
+    }
+    members[static_cast<std::size_t>(*id)].push_back(i);
+  }
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const Cell& c = cells[k];
+    const std::vector<int>& here = members[k];
+    for (std::int64_t dx = -2; dx <= 2; ++dx) {
+      for (std::int64_t dy = -2; dy <= 2; ++dy) {
+        for (std::int64_t dz = -2; dz <= 2; ++dz) {
+          const Cell other{c[0] + dx, c[1] + dy, c[2] + dz};
+          if (other <= c) continue;  // each pair of cells once
+          const int* id = slot(other);
+          if (id == nullptr || *id < 0) continue;
+          const std::vector<int>& there = members[static_cast<std::size_t>(*id)];
+          if (find_root(parent, here.front()) == find_root(parent, there.front())) continue;
+          const auto linked = [&] {
+            for (const int i : here) {
+              for (const int j : there) {
+                if (close(i, j)) return true;
+              }
+            }
+            return false;
+          };
+          if (linked()) unite(here.front(), there.front());
         }
       }
+    }
+  }
+  for (const int i : far) {
+    for (int j = 0; j < n; ++j) {
+      if (j != i && finite[static_cast<std::size_t>(j)] && close(i, j)) unite(i, j);
     }
   }
   // Roots are each cluster's smallest index, so clusters come in order of their first point.

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 
 namespace ofv {
@@ -38,6 +40,54 @@ TEST(OccluderTracker, ClustersAreChainsOfNearPoints) {
   bad(0, 3) = std::nan("");
   clusters = cluster_points(bad, 0.05);
   EXPECT_EQ(clusters[0].size() + clusters[1].size(), 63U);
+}
+
+// Single linkage by its definition: every pair closer than `link` joined.
+std::vector<std::vector<int>> clusters_by_every_pair(const Eigen::Matrix3Xd& p, double link) {
+  const auto n = static_cast<int>(p.cols());
+  std::vector<int> label(static_cast<std::size_t>(n), -1);
+  std::vector<std::vector<int>> clusters;
+  for (int seed = 0; seed < n; ++seed) {
+    if (label[static_cast<std::size_t>(seed)] >= 0 || !p.col(seed).allFinite()) continue;
+    const int id = static_cast<int>(clusters.size());
+    std::vector<int> members{seed};
+    label[static_cast<std::size_t>(seed)] = id;
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      for (int j = 0; j < n; ++j) {
+        if (label[static_cast<std::size_t>(j)] < 0 && p.col(j).allFinite() &&
+            (p.col(members[k]) - p.col(j)).squaredNorm() < link * link) {
+          label[static_cast<std::size_t>(j)] = id;
+          members.push_back(j);
+        }
+      }
+    }
+    std::sort(members.begin(), members.end());
+    clusters.push_back(members);
+  }
+  return clusters;
+}
+
+TEST(OccluderTracker, ClustersEqualThoseOfJoiningEveryNearPair) {
+  // Random clouds from sparse to dense, with points on cell boundaries,
+  // far-out points (beyond any cell index) and non-finite ones.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 60; ++trial) {
+    const double link = trial % 3 == 0 ? 0.05 : (trial % 3 == 1 ? 0.013 : 0.2);
+    const int n = 20 + 40 * (trial % 7);
+    const double extent = 0.1 + 0.1 * (trial % 5);
+    Eigen::Matrix3Xd p(3, n);
+    for (int i = 0; i < n; ++i) p.col(i) = extent * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    if (trial % 4 == 0) p.col(1) = Eigen::Vector3d(link, 0.5 * link, -link);  // on cell corners
+    if (trial % 4 == 0) p.col(2) = Eigen::Vector3d(link, 0.5 * link, -0.5 * link);
+    if (trial % 5 == 0) p.col(3) = Eigen::Vector3d(1e300, 0.0, 0.0);
+    if (trial % 5 == 0) p.col(4) = Eigen::Vector3d(1e300, 0.0, 0.01 * link);  // linked to the one above
+    if (trial % 6 == 0) p(1, 5) = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(cluster_points(p, link), clusters_by_every_pair(p, link)) << "trial " << trial;
+  }
+  // Far apart clusters: the grid falls back from a table to a hash map.
+  Eigen::Matrix3Xd spread = join(block({0, 0, 0}), block({5000.0, -3000.0, 2000.0}));
+  EXPECT_EQ(cluster_points(spread, 0.05), clusters_by_every_pair(spread, 0.05));
 }
 
 TEST(OccluderTracker, VelocityOfANoisyTranslatingClusterWithinThreeCentimetresPerSecond) {
