@@ -132,41 +132,52 @@ SettingsTable<EstimatorParams> make_table() {
          "max_iterations = 50"},
         [](P& p, const std::string& v) {
           p.preset = parse_word<Preset>("preset", v, {{"paper", Preset::Paper}, {"authors_code", Preset::AuthorsCode}});
-        });
+        },
+        [](const P& p) { return std::string(to_string(p.preset)); });
   t.add({"r_seed", "number in (0, 1e4]", format_number(d.r_seed), "m", "supervoxel seed resolution R_seed"},
-        [](P& p, const std::string& v) { p.r_seed = parse_number("r_seed", v, -kInf, kInf, false); });
+        [](P& p, const std::string& v) { p.r_seed = parse_number("r_seed", v, -kInf, kInf, false); },
+        [](const P& p) { return format_number(p.resolve().r_seed); });
   t.add({"r_sphere", "number in (0, 1e4]", format_number(d.r_sphere), "m", "radius of the solution sphere around the object"},
-        [](P& p, const std::string& v) { p.r_sphere = parse_number("r_sphere", v, -kInf, kInf, false); });
+        [](P& p, const std::string& v) { p.r_sphere = parse_number("r_sphere", v, -kInf, kInf, false); },
+        [](const P& p) { return format_number(p.resolve().r_sphere); });
   t.add({"initial_view", "spherical_mean | vector_mean", to_string(d.initial_view), "",
          "how t0 averages the normals-to-sphere rays"},
         [](P& p, const std::string& v) {
           p.initial_view = parse_word<InitialView>(
               "initial_view", v, {{"spherical_mean", InitialView::SphericalMean}, {"vector_mean", InitialView::VectorMean}});
-        });
+        },
+        [](const P& p) { return std::string(to_string(p.resolve().initial_view)); });
   t.add({"clearance", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.clearance), "m",
          "the view is clear when no projected occlusion point is closer (paper: r_seed)"},
-        [](P& p, const std::string& v) { p.clearance = length(p, "clearance", v); });
+        [](P& p, const std::string& v) { p.clearance = length(p, "clearance", v); },
+        [](const P& p) { return format_number(p.resolve().clearance); });
   t.add({"push_radius", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.push_radius), "m",
          "projected points closer than this push the view (paper: r_sphere; r_seed is the other reading)"},
-        [](P& p, const std::string& v) { p.push_radius = length(p, "push_radius", v); });
+        [](P& p, const std::string& v) { p.push_radius = length(p, "push_radius", v); },
+        [](const P& p) { return format_number(p.resolve().push_radius); });
   t.add({"push_weighting", "sum | inverse_distance", to_string(d.push_weighting), "",
          "sum of the pushes, or each divided by its squared length"},
         [](P& p, const std::string& v) {
           p.push_weighting = parse_word<PushWeighting>(
               "push_weighting", v, {{"sum", PushWeighting::Sum}, {"inverse_distance", PushWeighting::InverseDistance}});
-        });
+        },
+        [](const P& p) { return std::string(to_string(p.resolve().push_weighting)); });
   t.add({"step", "number in (0, 1e4] | r_seed | r_sphere", format_number(d.step), "m",
          "length of one push on the tangent plane (paper: r_seed)"},
-        [](P& p, const std::string& v) { p.step = length(p, "step", v); });
+        [](P& p, const std::string& v) { p.step = length(p, "step", v); },
+        [](const P& p) { return format_number(p.resolve().step); });
   t.add({"max_iterations", "integer in [0, 100000000]", std::to_string(d.max_iterations), "",
          "push steps before giving up with the best visited view"},
-        [](P& p, const std::string& v) { p.max_iterations = static_cast<int>(parse_integer("max_iterations", v, 0, kMaxIterations)); });
+        [](P& p, const std::string& v) { p.max_iterations = static_cast<int>(parse_integer("max_iterations", v, 0, kMaxIterations)); },
+        [](const P& p) { return std::to_string(p.resolve().max_iterations); });
   t.add({"warm_start", "bool", format_bool(d.warm_start), "", "start from the previous frame's view instead of t0"},
-        [](P& p, const std::string& v) { p.warm_start = parse_bool("warm_start", v); });
+        [](P& p, const std::string& v) { p.warm_start = parse_bool("warm_start", v); },
+        [](const P& p) { return format_bool(p.resolve().warm_start); });
   t.add({"time_budget", "number in (0, 3600]", format_number(d.time_budget), "s",
          "wall time one estimate may take (ofv's bound, not the spec's): then the best visited view, status "
          "out_of_time; up to 3600"},
-        [](P& p, const std::string& v) { p.time_budget = parse_number("time_budget", v, 0.0, 3600.0, true); });
+        [](P& p, const std::string& v) { p.time_budget = parse_number("time_budget", v, 0.0, 3600.0, true); },
+        [](const P& p) { return format_number(p.resolve().time_budget); });
   return t;
 }
 

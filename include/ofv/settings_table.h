@@ -46,19 +46,24 @@ class SettingsTable {
   /// \brief Parses `value` and writes it into the settings.
   /// \throws std::invalid_argument naming the setting and the value.
   using Setter = std::function<void(T&, const std::string& value)>;
+  /// \brief The setting's value as text that the setter reads back (the
+  ///        resolved value: a preset's or scenario's, where they apply).
+  using Getter = std::function<std::string(const T&)>;
 
   /// \brief Adds a row.
-  SettingsTable& add(SettingDoc doc, Setter set) {
-    rows_.push_back({std::move(doc), std::move(set)});
+  SettingsTable& add(SettingDoc doc, Setter set, Getter get) {
+    rows_.push_back({std::move(doc), std::move(set), std::move(get)});
     return *this;
   }
 
-  /// \brief Adds every row of another table, writing through `part`, which
-  ///        returns the sub-settings of a T (e.g. `[](Loop& l) -> Estimator& { return l.estimator; }`).
+  /// \brief Adds every row of another table, reading and writing through
+  ///        `part`, which returns the sub-settings of a T, const or not
+  ///        (e.g. `[](auto& l) -> auto& { return l.estimator; }`).
   template <class U, class Part>
   SettingsTable& include(const SettingsTable<U>& other, Part part) {
     for (const auto& row : other.rows()) {
-      rows_.push_back({row.doc, [set = row.set, part](T& t, const std::string& v) { set(part(t), v); }});
+      rows_.push_back({row.doc, [set = row.set, part](T& t, const std::string& v) { set(part(t), v); },
+                       [get = row.get, part](const T& t) { return get(part(t)); }});
     }
     return *this;
   }
@@ -80,6 +85,14 @@ class SettingsTable {
     for (const auto& [name, value] : settings) set(target, name, value);
   }
 
+  /// \brief Every setting's value, in table order: `apply()` of them gives
+  ///        the same values again.
+  [[nodiscard]] std::vector<std::pair<std::string, std::string>> values(const T& source) const {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const auto& row : rows_) out.emplace_back(row.doc.name, row.get(source));
+    return out;
+  }
+
   /// \brief The row named `name`, or nullptr.
   [[nodiscard]] const SettingDoc* find(const std::string& name) const {
     for (const auto& row : rows_) {
@@ -98,6 +111,7 @@ class SettingsTable {
   struct Row {
     SettingDoc doc;
     Setter set;
+    Getter get;
   };
   [[nodiscard]] const std::vector<Row>& rows() const { return rows_; }
 

@@ -168,5 +168,31 @@ TEST(Episode, EveryNumericSettingDocumentsTheRangeItChecks) {
   EXPECT_GE(checked, 29);
 }
 
+TEST(Episode, ResolvedSettingsReadBackToTheSameEpisode) {
+  // Every setting's resolved value (the preset's and the scenario's where
+  // they apply), given back as settings, resolves to the same values.
+  const sim::Scenario scenario = sim::load_scenario(kOnRay);
+  const EpisodeSetup setup = resolve_episode(
+      scenario, {{"preset", "authors_code"}, {"r_seed", "0.01"}, {"workspace", "-1,-1,0,1,1,2.5"},
+                 {"anticipation", "predict"}, {"seed", "4"}, {"latency", "1"}, {"perception", "ground-truth"}});
+  const auto values = episode_settings_table().values(setup);
+  ASSERT_EQ(values.size(), episode_settings_table().docs().size());
+  const auto value = [&](const std::string& name) {
+    for (const auto& [k, v] : values) {
+      if (k == name) return v;
+    }
+    return std::string("(absent)");
+  };
+  EXPECT_EQ(value("preset"), "authors_code");
+  EXPECT_EQ(value("step"), "0.005");  // the preset's r_seed / 2, with the final r_seed
+  EXPECT_EQ(value("clearance"), "0.02");
+  EXPECT_EQ(value("max_iterations"), "50");
+  EXPECT_EQ(value("workspace"), "-1,-1,0,1,1,2.5");
+  EXPECT_EQ(value("anticipation"), "predict");
+  EXPECT_EQ(value("seed"), "4");
+  EXPECT_EQ(value("duration"), format_number(scenario.duration));
+  EXPECT_EQ(episode_settings_table().values(resolve_episode(scenario, values)), values);
+}
+
 }  // namespace
 }  // namespace ofv

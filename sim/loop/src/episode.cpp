@@ -26,27 +26,33 @@ SettingsTable<EpisodeSetup> make_table() {
   using E = EpisodeSetup;
   const EpisodeSetup d;
   SettingsTable<E> t;
-  t.include(loop_settings_table(), [](E& e) -> LoopSettings& { return e.loop; });
+  t.include(loop_settings_table(), [](auto& e) -> auto& { return e.loop; });
   t.add({"robot", "camera | viper850 | afma6", "the scenario's", "",
          "free-flying camera, or the arm on ViSP's kinematic model (threaded simulator with real_time)"},
-        [](E& e, const std::string& v) { e.robot = parse_robot_kind(v); });
+        [](E& e, const std::string& v) { e.robot = parse_robot_kind(v); },
+        [](const E& e) { return std::string(to_string(e.robot)); });
   t.add({"perception", "full | ground-truth", to_string(d.perception), "",
          "PCL front end on the frames, or the simulator's ground-truth supervoxels"},
         [](E& e, const std::string& v) {
           e.perception = parse_word<PerceptionMode>("perception", v,
                                                     {{"full", PerceptionMode::Full}, {"ground-truth", PerceptionMode::GroundTruth}});
-        });
+        },
+        [](const E& e) { return std::string(to_string(e.perception)); });
   t.add({"duration", "number in (0, 86400]", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
-        [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, kMaxEpisodeDuration, true); });
+        [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, kMaxEpisodeDuration, true); },
+        [](const E& e) { return format_number(e.duration); });
   t.add({"seed", "integer in [0, 1000000000]", std::to_string(d.seed), "",
          "the scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement"},
-        [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); });
+        [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); },
+        [](const E& e) { return std::to_string(e.seed); });
   t.add({"latency", "integer in [0, 30]", std::to_string(d.latency), "frames",
          "delay between capturing a frame and applying its command (simulation), 0 to 30"},
-        [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); });
+        [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); },
+        [](const E& e) { return std::to_string(e.latency); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
          "run the arm on ViSP's threaded simulator in wall-clock time (robot viper850 or afma6)"},
-        [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); });
+        [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); },
+        [](const E& e) { return format_bool(e.real_time); });
   return t;
 }
 
