@@ -1,6 +1,8 @@
 // ofv: occlusion-free view estimation and visual servoing.
 #include "commands.h"
 
+#include "ofv/version.h"
+
 #include <iostream>
 #include <string>
 #include <vector>
@@ -13,6 +15,7 @@ int main(int argc, char** argv) {
       "Object Perception\"). Run 'ofv COMMAND --help' for a command's options."};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Print the help of every command");
+  app.set_version_flag("--version", std::string("ofv ") + ofv::version() + " (git " + ofv::git_commit() + ")");
 
   std::vector<Command> commands;
 #ifdef OFV_HAVE_LOOP  // built with the simulator, the servo library and perception
@@ -46,6 +49,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << "ofv: " << e.what() << " (see 'ofv --help')\n";

@@ -205,6 +205,7 @@ Body body(const Node& n, Role role, const std::string& default_name, const std::
     const double scale = n.has("scale") ? n.child("scale").positive(kMaxScale) : 1.0;
     try {
       b.mesh = read_mesh(file.string(), scale);
+      b.mesh_file = file.string();
     } catch (const std::runtime_error& e) {
       n.child("file").fail(e.what());
     }

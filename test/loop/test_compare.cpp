@@ -1,6 +1,7 @@
 // The comparison sweep (planning, shards, parallel resumable runs, merge)
 // with a synthetic, deterministic episode runner.
 #include "ofv/loop/compare.h"
+#include "ofv/version.h"
 
 #include <gtest/gtest.h>
 
@@ -17,6 +18,10 @@ namespace ofv {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The scenario file of every planned episode (the synthetic runner does not
+// run it; planning fingerprints its files).
+const std::string kScenario = std::string(OFV_TEST_DATA_DIR) + "/loop/hand-on-initial-ray.yaml";
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -44,7 +49,7 @@ EpisodeOutcome synthetic(const EpisodeSpec& spec) {
     s.status = StepStatus::Converged;
     s.times.estimate = 1e-5;
   }
-  return {summarise(steps), steps};
+  return {summarise(steps), steps, {}};
 }
 
 class Compare : public testing::Test {
@@ -59,14 +64,14 @@ class Compare : public testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
   std::vector<EpisodeSpec> plan() const {
     const Grid grid = grid_from_yaml("name: g\nseeds: 3\naxes:\n  gain: [0.5, 1, 2]\n", "g.yaml");
-    return plan_episodes({{"one", "one.yaml"}, {"two", "two.yaml"}}, grid);
+    return plan_episodes({{"one", kScenario}, {"two", kScenario}}, grid);
   }
   fs::path dir_;
 };
 
 TEST(Grid, ShardsPartitionTheSweep) {
   const Grid g = grid_from_yaml("seeds: 5\naxes:\n  gain: [1, 2, 3]", "g");
-  const auto all = plan_episodes({{"a", "a"}, {"b", "b"}}, g);
+  const auto all = plan_episodes({{"a", kScenario}, {"b", kScenario}}, g);
   ASSERT_EQ(all.size(), 30U);
   std::size_t total = 0;
   for (int k = 1; k <= 4; ++k) total += shard(all, k, 4).size();
@@ -174,7 +179,7 @@ TEST_F(Compare, ReportsAggregateOverSeeds) {
 class SweepFiles : public Compare {
  protected:
   static std::vector<EpisodeSpec> plan_of(const std::string& yaml) {
-    return plan_episodes({{"one", "one.yaml"}, {"two", "two.yaml"}}, grid_from_yaml(yaml, "g.yaml"));
+    return plan_episodes({{"one", kScenario}, {"two", kScenario}}, grid_from_yaml(yaml, "g.yaml"));
   }
   static std::size_t json_files(const fs::path& dir) {
     std::size_t n = 0;
@@ -301,28 +306,70 @@ TEST_F(SweepFiles, MergeRefusesPartsOfDifferentSweeps) {
   }
 }
 
-TEST_F(SweepFiles, MergeRefusesTheSameEpisodeWithDifferentResults) {
-  // Shards 1/2 and 1/3 overlap (episodes 0, 6, 12, ...); run apart, their
-  // results differ (here: another runner; in practice another machine).
+// Replaces the first `from` in a file by `to`.
+void edit(const fs::path& file, const std::string& from, const std::string& to) {
+  std::string text = slurp(file);
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << file << " has no " << from;
+  text.replace(at, from.size(), to);
+  std::ofstream(file) << text;
+}
+
+TEST_F(SweepFiles, MergeRefusesOverlappingPartsAndPartsOfOtherCode) {
+  // Shards 1/2 and 1/3 overlap (episodes 0, 6, 12, ...).
   run_sweep(plan(), synthetic, (dir_ / "p1").string(), {1, false, {1, 2}});
-  const EpisodeRunner other = [](const EpisodeSpec& s) {
-    EpisodeOutcome o = synthetic(s);
-    o.metrics.mean_visible_fraction += 0.01;
-    return o;
+  run_sweep(plan(), synthetic, (dir_ / "p2").string(), {1, false, {1, 3}});
+  const auto refused_merge = [&](const std::vector<std::string>& dirs) {
+    try {
+      (void)read_sweep(dirs);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("merged");
   };
-  run_sweep(plan(), other, (dir_ / "p2").string(), {1, false, {1, 3}});
-  try {
-    (void)read_sweep({(dir_ / "p1").string(), (dir_ / "p2").string()});
-    ADD_FAILURE() << "merged";
-  } catch (const std::invalid_argument& e) {
-    const std::string id = plan()[0].id();
-    EXPECT_EQ(contains(e.what(), {(dir_ / "p1" / "episodes" / (id + ".json")).string(),
-                                  (dir_ / "p2" / "episodes" / (id + ".json")).string(), "different results"}),
-              "");
-  }
-  // A copy of a part is no conflict: its episodes count once.
+  const std::string p1 = (dir_ / "p1").string(), p2 = (dir_ / "p2").string();
+  EXPECT_EQ(contains(refused_merge({p1, p2}), {p1 + "/sweep.json", p2 + "/sweep.json", "1/2", "1/3", "overlap",
+                                               "episode 0", plan()[0].id()}),
+            "");
+  // A part given twice, or a copy of it, overlaps itself.
   fs::copy(dir_ / "p1", dir_ / "copy", fs::copy_options::recursive);
-  EXPECT_EQ(read_sweep({(dir_ / "p1").string(), (dir_ / "copy").string()}).rows.size(), plan().size() / 2);
+  EXPECT_EQ(contains(refused_merge({p1, (dir_ / "copy").string()}), {"1/2", "overlap"}), "");
+  EXPECT_EQ(contains(refused_merge({p1, p1}), {"overlap"}), "");
+  // Part 2/2 run by another build of ofv.
+  run_sweep(plan(), synthetic, (dir_ / "q2").string(), {1, false, {2, 2}});
+  EXPECT_EQ(read_sweep({p1, (dir_ / "q2").string()}).rows.size(), plan().size());
+  const std::string ours = std::string(version()) + " (git " + git_commit() + ")";
+  edit(dir_ / "q2" / "sweep.json", ours, "0.0.9 (git 0123abc)");
+  EXPECT_EQ(contains(refused_merge({p1, (dir_ / "q2").string()}),
+                     {p1 + "/sweep.json", "q2/sweep.json", "different ofv", ours, "0.0.9 (git 0123abc)"}),
+            "");
+  // An episode file that another ofv wrote, in a folder of this one.
+  edit(dir_ / "q2" / "sweep.json", "0.0.9 (git 0123abc)", ours);
+  const fs::path episode = dir_ / "q2" / "episodes" / (plan()[1].id() + ".json");
+  edit(episode, ours, "0.0.9 (git 0123abc)");
+  EXPECT_EQ(contains(refused_merge({p1, (dir_ / "q2").string()}), {episode.string(), "0.0.9 (git 0123abc)"}), "");
+  // An episode of part 1/2 copied into the folder of part 2/2.
+  edit(episode, "0.0.9 (git 0123abc)", ours);
+  const fs::path stray = dir_ / "q2" / "episodes" / (plan()[0].id() + ".json");
+  fs::copy_file(dir_ / "p1" / "episodes" / (plan()[0].id() + ".json"), stray);
+  EXPECT_EQ(contains(refused_merge({p1, (dir_ / "q2").string()}), {stray.string(), "part 2/2"}), "");
+}
+
+TEST_F(SweepFiles, ResumeRefusesAFolderOfOtherCodeOrAnEditedScenario) {
+  const auto all = plan();
+  run_sweep(all, synthetic, dir_.string(), {1, false, {}});
+  const std::string ours = std::string(version()) + " (git " + git_commit() + ")";
+  edit(dir_ / "sweep.json", ours, "0.0.9 (git 0123abc)");
+  EXPECT_EQ(contains(refused(all, dir_), {"sweep.json", "0.0.9 (git 0123abc)", ours, "another --out"}), "");
+  edit(dir_ / "sweep.json", "0.0.9 (git 0123abc)", ours);
+  EXPECT_EQ(run_sweep(all, synthetic, dir_.string(), {1, false, {}}), 0);
+  // The same scenario name, its file edited: another sweep.
+  const fs::path edited = dir_ / "one.yaml";
+  fs::copy_file(kScenario, edited);
+  std::ofstream(edited, std::ios::app) << "# edited\n";
+  const Grid grid = grid_from_yaml("name: g\nseeds: 3\naxes:\n  gain: [0.5, 1, 2]\n", "g.yaml");
+  const auto changed = plan_episodes({{"one", edited.string()}, {"two", kScenario}}, grid);
+  EXPECT_EQ(contains(refused(changed, dir_), {"sweep.json", "scenario 'one'", "edited"}), "");
 }
 
 TEST_F(SweepFiles, MergeNamesTheMissingEpisodes) {
@@ -358,7 +405,7 @@ TEST_F(SweepFiles, PlotsRunNoShellAndQuoteEveryName) {
   const fs::path out = dir_ / ("o'$(" + touch + ")'\";" + touch + ";\"`" + touch + "`");
   Grid grid = grid_from_yaml("seeds: 1\naxes: {gain: [1, 2]}\n", "g.yaml");
   grid.variants[1].name = "v'\nsystem '" + touch + "'\n'";
-  const auto all = plan_episodes({{"s' . system('" + touch + "') . '", "s.yaml"}}, grid);
+  const auto all = plan_episodes({{"s' . system('" + touch + "') . '", kScenario}}, grid);
   run_sweep(all, synthetic, out.string(), {1, false, {}});
   const auto pngs = write_reports(load_episodes({out.string()}), out.string());
   EXPECT_FALSE(fs::exists(marker)) << "a name ran a command";
@@ -377,7 +424,7 @@ TEST_F(SweepFiles, AMetricWithNoValueHasNoChartAndTheOthersAreDrawn) {
     o.metrics = summarise(o.steps);
     return o;
   };
-  const auto all = plan_episodes({{"hidden", "s.yaml"}}, grid_from_yaml("seeds: 1\naxes: {gain: [1, 2]}\n", "g.yaml"));
+  const auto all = plan_episodes({{"hidden", kScenario}}, grid_from_yaml("seeds: 1\naxes: {gain: [1, 2]}\n", "g.yaml"));
   run_sweep(all, never, dir_.string(), {1, false, {}});
   const auto pngs = write_reports(load_episodes({dir_.string()}), dir_.string());
   ASSERT_EQ(pngs.size(), 4U) << "gnuplot failed: " << slurp(dir_ / "plots" / "gnuplot.log");

@@ -2,6 +2,11 @@
 // one line naming the file or option, the field and the value), resume and
 // merge of real output folders.
 #include "cli_run.h"
+#include "ofv/loop/episode.h"
+#include "ofv/loop/sweep.h"
+#include "ofv/version.h"
+
+#include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
 
@@ -120,6 +125,18 @@ TEST_F(SweepCli, ResumeRunsTheRestAndRefusesAnotherGridsFolder) {
   const std::string g2 = sh(write("g2.yaml", kShort + "seeds: 1\nvariants:\n  - {name: fast, set: {gain: 3}}\n").string());
   const std::string out = " --out " + sh((dir_ / "o").string());
   ASSERT_EQ(run("compare --scenarios dvd-one-hand --grid " + g1 + out).code, 0);
+  // The episode records what produced it: this ofv and every setting as resolved.
+  for (const auto& e : fs::directory_iterator(dir_ / "o" / "episodes")) {
+    if (e.path().extension() != ".json") continue;
+    std::ifstream in(e.path());
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j.at("provenance").at("ofv"), std::string(version()) + " (git " + git_commit() + ")");
+    const auto& settings = j.at("provenance").at("settings");
+    EXPECT_EQ(settings.size(), episode_settings_table().docs().size());
+    EXPECT_NE(std::find(settings.begin(), settings.end(), nlohmann::json{"gain", "2"}), settings.end()) << settings;
+    EXPECT_NE(std::find(settings.begin(), settings.end(), nlohmann::json{"seed", "0"}), settings.end()) << settings;
+    EXPECT_EQ(j.at("scenario_hash"), scenario_fingerprint("dvd-one-hand"));
+  }
   const CommandRun again = run("compare --scenarios dvd-one-hand --grid " + g1 + out);
   EXPECT_EQ(again.code, 0) << again.err;
   EXPECT_NE(again.out.find("(0 run, 1 resumed)"), std::string::npos) << again.out;
@@ -144,9 +161,10 @@ TEST_F(SweepCli, MergeRefusesOtherSweepsAndConflictsAndNamesWhatIsMissing) {
   // Parts of two grids.
   expect_usage_error("--merge " + p1 + " " + q2 + " --out " + sh((dir_ / "m2").string()),
                      {(dir_ / "p1" / "sweep.json").string(), (dir_ / "q2" / "sweep.json").string(), "gain=3"});
-  // The same episode run twice (part 1/2 and the whole sweep), with other results.
+  // Overlapping parts: part 1/2 and the whole sweep both ran episode 0.
   expect_usage_error("--merge " + p1 + " " + whole + " --out " + sh((dir_ / "m3").string()),
-                     {(dir_ / "p1" / "episodes").string(), (dir_ / "whole" / "episodes").string(), "different results"});
+                     {(dir_ / "p1" / "sweep.json").string(), (dir_ / "whole" / "sweep.json").string(), "1/2", "1/1",
+                      "overlap"});
   expect_usage_error("--merge " + p1 + " " + p2 + " --jobs 2 --out " + sh((dir_ / "m2").string()), {"--merge", "--jobs"});
   EXPECT_FALSE(fs::exists(dir_ / "m2"));
   EXPECT_FALSE(fs::exists(dir_ / "m3"));

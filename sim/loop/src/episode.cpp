@@ -241,7 +241,10 @@ EpisodeRunner simulation_runner() {
     auto settings = spec.variant.settings;
     // Seed k of a scenario is the same world for every variant.
     settings.emplace_back("seed", std::to_string(spec.seed));
-    return run_episode(resolve_episode(sim::load_scenario(spec.scenario_path), settings));
+    const EpisodeSetup setup = resolve_episode(sim::load_scenario(spec.scenario_path), settings);
+    EpisodeOutcome outcome = run_episode(setup);
+    outcome.settings = episode_settings_table().values(setup);
+    return outcome;
   };
 }
 

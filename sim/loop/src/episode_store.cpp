@@ -3,6 +3,7 @@
 #include "ofv/loop/episode_store.h"
 
 #include "ofv/loop/metrics_json.h"
+#include "ofv/version.h"
 
 #include <nlohmann/json.hpp>
 
@@ -22,7 +23,10 @@ using nlohmann::json;
 
 namespace {
 
-constexpr const char* kSweepFormat = "ofv compare sweep 1";
+constexpr const char* kSweepFormat = "ofv compare sweep 2";
+
+// Which ofv ran a folder's episodes: `0.1.0 (git <commit>)`.
+std::string this_ofv() { return std::string(version()) + " (git " + git_commit() + ")"; }
 
 json settings_to_json(const std::vector<std::pair<std::string, std::string>>& settings) {
   json out = json::array();
@@ -37,9 +41,14 @@ std::vector<std::pair<std::string, std::string>> settings_from_json(const json& 
 }
 
 json spec_to_json(const EpisodeSpec& s) {
-  return {{"index", s.index},     {"id", s.id()},           {"scenario", s.scenario},
-          {"scenario_path", s.scenario_path}, {"variant", s.variant.name},
-          {"settings", settings_to_json(s.variant.settings)}, {"seed", s.seed}};
+  return {{"index", s.index},
+          {"id", s.id()},
+          {"scenario", s.scenario},
+          {"scenario_path", s.scenario_path},
+          {"scenario_hash", s.scenario_hash},
+          {"variant", s.variant.name},
+          {"settings", settings_to_json(s.variant.settings)},
+          {"seed", s.seed}};
 }
 
 EpisodeSpec spec_from_json(const json& j) {
@@ -47,6 +56,7 @@ EpisodeSpec spec_from_json(const json& j) {
   s.index = j.at("index").get<int>();
   s.scenario = j.at("scenario").get<std::string>();
   s.scenario_path = j.at("scenario_path").get<std::string>();
+  s.scenario_hash = j.at("scenario_hash").get<std::string>();
   s.variant.name = j.at("variant").get<std::string>();
   s.variant.settings = settings_from_json(j.at("settings"));
   s.seed = j.at("seed").get<int>();
@@ -71,6 +81,10 @@ std::string settings_text(const std::vector<std::pair<std::string, std::string>>
 // expected (here); empty when they are the same episode.
 std::string episode_difference(const EpisodeSpec& there, const EpisodeSpec& here) {
   if (there.scenario != here.scenario) return "scenario '" + there.scenario + "' there, '" + here.scenario + "' here";
+  if (there.scenario_hash != here.scenario_hash) {
+    return "scenario '" + here.scenario + "' with files of fingerprint " + there.scenario_hash + " there, " +
+           here.scenario_hash + " here (the scenario or a mesh was edited)";
+  }
   if (there.variant.name != here.variant.name) {
     return "variant '" + there.variant.name + "' there, '" + here.variant.name + "' here";
   }
@@ -117,6 +131,14 @@ std::string plan_difference(const std::vector<EpisodeSpec>& there, const std::ve
     const auto a = distinct(there, get), b = distinct(here, get);
     if (a != b) return std::string(what) + " " + list_text(a) + " there, " + list_text(b) + " here";
   }
+  std::map<std::string, const EpisodeSpec*> by_scenario;
+  for (const auto& s : there) by_scenario.emplace(s.scenario, &s);
+  for (const auto& s : here) {
+    const auto it = by_scenario.find(s.scenario);
+    if (it != by_scenario.end() && it->second->scenario_hash != s.scenario_hash) {
+      return episode_difference(*it->second, s);
+    }
+  }
   std::map<std::string, const EpisodeSpec*> by_name;
   for (const auto& s : there) by_name.emplace(s.variant.name, &s);
   for (const auto& s : here) {
@@ -138,32 +160,39 @@ json plan_to_json(const std::vector<EpisodeSpec>& plan, const Shard& part) {
   std::map<std::string, std::size_t> scenario_at, variant_at;
   for (const auto& s : plan) {
     const auto [si, new_scenario] = scenario_at.emplace(s.scenario, scenario_at.size());
-    if (new_scenario) scenarios.push_back(s.scenario);
+    if (new_scenario) scenarios.push_back({{"name", s.scenario}, {"hash", s.scenario_hash}});
     const std::string vkey = json{s.variant.name, settings_to_json(s.variant.settings)}.dump();
     const auto [vi, new_variant] = variant_at.emplace(vkey, variant_at.size());
     if (new_variant) variants.push_back({{"name", s.variant.name}, {"settings", settings_to_json(s.variant.settings)}});
     episodes.push_back({si->second, vi->second, s.seed, s.index});
   }
-  return {{"format", kSweepFormat}, {"fingerprint", plan_fingerprint(plan)}, {"part", part_text(part)},
-          {"scenarios", scenarios}, {"variants", variants}, {"episodes", episodes}};
+  return {{"format", kSweepFormat}, {"ofv", this_ofv()},          {"fingerprint", plan_fingerprint(plan)},
+          {"part", part_text(part)},  {"scenarios", scenarios}, {"variants", variants},
+          {"episodes", episodes}};
 }
 
 struct SweepRecord {
   std::vector<EpisodeSpec> plan;
   Shard part;
+  std::string ofv;  ///< which ofv ran the folder's episodes
 };
 
 SweepRecord read_record(const fs::path& file) {
   SweepRecord r;
   try {
     const json j = json::parse(slurp(file));
-    if (j.at("format") != kSweepFormat) throw std::runtime_error("format is not '" + std::string(kSweepFormat) + "'");
+    if (j.at("format") != kSweepFormat) {
+      throw std::runtime_error("format is not '" + std::string(kSweepFormat) + "' (a folder of an older ofv?)");
+    }
     r.part = parse_shard(j.at("part").get<std::string>());
+    r.ofv = j.at("ofv").get<std::string>();
     const json& scenarios = j.at("scenarios");
     const json& variants = j.at("variants");
     for (const auto& e : j.at("episodes")) {
       EpisodeSpec s;
-      s.scenario = scenarios.at(e.at(0).get<std::size_t>()).get<std::string>();
+      const json& scenario = scenarios.at(e.at(0).get<std::size_t>());
+      s.scenario = scenario.at("name").get<std::string>();
+      s.scenario_hash = scenario.at("hash").get<std::string>();
       const json& v = variants.at(e.at(1).get<std::size_t>());
       s.variant.name = v.at("name").get<std::string>();
       s.variant.settings = settings_from_json(v.at("settings"));
@@ -232,6 +261,11 @@ EpisodeStore::EpisodeStore(const std::string& out_dir, const std::vector<Episode
       throw std::invalid_argument(record.string() + ": the folder holds part " + part_text(there.part) +
                                   " of this sweep, not " + part_text(part) + ": give another --out");
     }
+    if (there.ofv != this_ofv()) {
+      throw std::invalid_argument(record.string() + ": the folder's episodes were run by ofv " + there.ofv +
+                                  ", this is ofv " + this_ofv() + " (results of other code are not mixed): give "
+                                  "another --out");
+    }
   } else if (fs::is_directory(dir_)) {
     for (const auto& e : fs::directory_iterator(dir_)) {
       if (e.path().extension() == ".json") {
@@ -258,20 +292,22 @@ void EpisodeStore::write(const EpisodeSpec& spec, const EpisodeOutcome& outcome)
   write_file_atomically(dir_ / (spec.id() + ".csv"), csv);
   // The JSON is written last: its presence marks the episode finished.
   json j = spec_to_json(spec);
+  // Every setting as resolved, in the order that applies them again.
+  j["provenance"] = {{"ofv", this_ofv()}, {"settings", settings_to_json(outcome.settings)}};
   j["metrics"] = metrics_to_json(outcome.metrics);
   write_file_atomically(dir_ / (spec.id() + ".json"), j.dump(1) + "\n");
 }
 
 SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
   SweepEpisodes out;
-  std::optional<SweepRecord> sweep;
-  fs::path sweep_file;
-  std::map<std::string, const EpisodeSpec*> planned;  // id -> the plan's episode
-  struct Found {
-    fs::path file;
-    json content;  // without the machine-dependent scenario path
+  struct Part {
+    fs::path record;
+    SweepRecord sweep;
   };
-  std::map<std::string, Found> found;
+  std::vector<Part> parts;
+  parts.reserve(dirs.size());  // `planned` points into the first part's plan
+  std::map<std::string, const EpisodeSpec*> planned;  // id -> the plan's episode
+  std::set<std::string> found;
   for (const auto& d : dirs) {
     const fs::path dir = fs::path(d) / "episodes";
     if (!fs::is_directory(dir)) throw std::invalid_argument(d + ": no episodes/ folder (not an ofv compare output)");
@@ -279,16 +315,27 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
     if (!fs::exists(record)) {
       throw std::invalid_argument(record.string() + ": missing (not an ofv compare output, or one of an older ofv)");
     }
-    SweepRecord r = read_record(record);
-    if (!sweep) {
-      sweep = std::move(r);
-      sweep_file = record;
-      for (const auto& s : sweep->plan) planned.emplace(s.id(), &s);
-    } else {
-      const std::string diff = plan_difference(sweep->plan, r.plan);
-      if (!diff.empty()) {
-        throw std::invalid_argument(sweep_file.string() + " and " + record.string() +
-                                    ": parts of different sweeps (" + diff + ")");
+    parts.push_back({record, read_record(record)});
+    const Part& part = parts.back();
+    if (parts.size() == 1) {
+      for (const auto& s : part.sweep.plan) planned.emplace(s.id(), &s);
+    }
+    for (std::size_t other = 0; other + 1 < parts.size(); ++other) {
+      const Part& earlier = parts[other];
+      const std::string both = earlier.record.string() + " and " + record.string();
+      const std::string diff = plan_difference(earlier.sweep.plan, part.sweep.plan);
+      if (!diff.empty()) throw std::invalid_argument(both + ": parts of different sweeps (" + diff + ")");
+      if (earlier.sweep.ofv != part.sweep.ofv) {
+        throw std::invalid_argument(both + ": parts run by different ofv (" + earlier.sweep.ofv + " there, " +
+                                    part.sweep.ofv + " here): results of other code are not mixed");
+      }
+      const Shard a = earlier.sweep.part, b = part.sweep.part;
+      for (const auto& s : part.sweep.plan) {
+        if (s.index % a.n == a.k - 1 && s.index % b.n == b.k - 1) {
+          throw std::invalid_argument(both + ": parts " + part_text(a) + " and " + part_text(b) +
+                                      " overlap (both run episode " + std::to_string(s.index) + ", " + s.id() +
+                                      "): merge parts that share no episode");
+        }
       }
     }
     std::vector<fs::path> files;
@@ -296,36 +343,35 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
       if (e.path().extension() == ".json") files.push_back(e.path());
     }
     std::sort(files.begin(), files.end());
+    const Shard mine = part.sweep.part;
     for (const auto& f : files) {
       auto [spec, j] = read_episode(f);
       const auto plan = planned.find(spec.id());
-      if (plan == planned.end() || !episode_difference(*plan->second, spec).empty()) {
-        throw std::invalid_argument(f.string() + ": not an episode of the sweep of " + record.string());
-      }
-      j.erase("scenario_path");
-      const auto [it, inserted] = found.emplace(spec.id(), Found{f, j});
-      if (!inserted) {
-        if (it->second.content != j) {
-          throw std::invalid_argument(it->second.file.string() + " and " + f.string() +
-                                      ": the same episode with different results (keep one of them)");
-        }
-        continue;  // the same file twice (e.g. a copied part)
+      if (plan == planned.end() || !episode_difference(*plan->second, spec).empty() ||
+          plan->second->index % mine.n != mine.k - 1) {
+        throw std::invalid_argument(f.string() + ": not an episode of part " + part_text(mine) +
+                                    " of the sweep of " + record.string());
       }
       EpisodeRow row;
       row.spec = spec;
       row.spec.index = plan->second->index;
       try {
+        const std::string ran_by = j.at("provenance").at("ofv").get<std::string>();
+        if (ran_by != part.sweep.ofv) {
+          throw std::runtime_error("run by ofv " + ran_by + ", its folder's by " + part.sweep.ofv);
+        }
         row.metrics = metrics_from_json(j.at("metrics"));
       } catch (const std::exception& e) {
-        throw std::invalid_argument(f.string() + ": not a finished episode: " + e.what());
+        throw std::invalid_argument(f.string() + ": not a finished episode of this folder: " + e.what());
       }
       row.trajectory_csv = (dir / (spec.id() + ".csv")).string();
+      found.insert(spec.id());
       out.rows.push_back(row);
     }
   }
-  if (sweep) {
-    out.planned = sweep->plan.size();
-    for (const auto& s : sweep->plan) {
+  if (!parts.empty()) {
+    out.planned = parts.front().sweep.plan.size();
+    for (const auto& s : parts.front().sweep.plan) {
       if (found.count(s.id()) == 0) out.missing.push_back(s);
     }
   }

@@ -3,6 +3,7 @@
 
 #include "ofv/loop/episode_store.h"
 #include "ofv/loop/progress.h"
+#include "ofv/sim/scenario.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -13,6 +14,7 @@
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -40,8 +42,26 @@ std::string fingerprint(const std::string& text) {
 std::string EpisodeSpec::identity() const {
   nlohmann::json settings = nlohmann::json::array();
   for (const auto& [k, v] : variant.settings) settings.push_back({k, v});
-  return nlohmann::json{{"scenario", scenario}, {"variant", variant.name}, {"settings", settings}, {"seed", seed}}
+  return nlohmann::json{{"scenario", scenario}, {"scenario_hash", scenario_hash}, {"variant", variant.name},
+                        {"settings", settings}, {"seed", seed}}
       .dump();
+}
+
+std::string scenario_fingerprint(const std::string& path) {
+  const sim::Scenario scenario = sim::load_scenario(path);
+  std::vector<std::string> files{scenario.path};
+  for (const sim::Body& b : scenario.bodies) {
+    if (!b.mesh_file.empty()) files.push_back(b.mesh_file);
+  }
+  std::string all;
+  for (const std::string& file : files) {
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    if (!in) throw std::invalid_argument(file + ": cannot be read");
+    all += std::to_string(bytes.str().size()) + ":" + bytes.str();
+  }
+  return fingerprint(all);
 }
 
 std::string EpisodeSpec::id() const {
@@ -77,12 +97,14 @@ std::vector<EpisodeSpec> plan_episodes(
   std::vector<EpisodeSpec> out;
   out.reserve(scenarios.size() * grid.variants.size() * static_cast<std::size_t>(grid.seeds));
   for (const auto& [name, path] : scenarios) {
+    const std::string hash = scenario_fingerprint(path);
     for (const Variant& v : grid.variants) {
       for (int seed = 0; seed < grid.seeds; ++seed) {
         EpisodeSpec s;
         s.index = static_cast<int>(out.size());
         s.scenario = name;
         s.scenario_path = path;
+        s.scenario_hash = hash;
         s.variant = v;
         s.seed = seed;
         out.push_back(s);

@@ -48,6 +48,7 @@ struct Body {
   Role role = Role::Occluder;
   std::string shape;                 ///< box, sphere, capsule, sheet, cloth, mesh, plane
   TriangleMesh mesh;                 ///< at rest, body frame
+  std::string mesh_file;             ///< shape mesh: the file it was read from
   Eigen::Vector3f colour{0.5f, 0.5f, 0.5f};  ///< RGB in [0, 1]
   Motion motion;
   /// Cloth only: travelling wave and bend along body x (see deform_sheet).

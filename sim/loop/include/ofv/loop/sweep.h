@@ -25,14 +25,17 @@ struct EpisodeSpec {
   int index = 0;           ///< position in the whole sweep (sharding and ordering)
   std::string scenario;    ///< scenario name (file stem)
   std::string scenario_path;
+  /// Fingerprint of the scenario's files (scenario_fingerprint()): an edited
+  /// scenario or mesh is another episode.
+  std::string scenario_hash;
   Variant variant;
   int seed = 0;
   /**
-   * \brief What makes two episodes the same: the scenario's name, the
-   *        variant's name, its settings in the order they apply, and the
-   *        seed — as canonical JSON text, so different episodes always have
-   *        different identities (the scenario's file path and the index are
-   *        not part of it).
+   * \brief What makes two episodes the same: the scenario's name and the
+   *        fingerprint of its files, the variant's name, its settings in the
+   *        order they apply, and the seed — as canonical JSON text, so
+   *        different episodes always have different identities (the
+   *        scenario's file path and the index are not part of it).
    */
   [[nodiscard]] std::string identity() const;
   /**
@@ -67,8 +70,16 @@ inline constexpr int kMaxJobs = 256;
 /// \throws std::invalid_argument giving the counts.
 void check_sweep_size(std::size_t scenarios, std::size_t variants, int seeds);
 
-/// \brief Every scenario x variant x seed, in a fixed order.
-/// \throws std::invalid_argument from check_sweep_size(), before anything is allocated.
+/// \brief The fingerprint of a scenario's files: the scenario file's bytes and
+///        those of every mesh it reads, in order (not their paths: a moved
+///        folder is the same scenario).
+/// \throws std::invalid_argument naming the file when the scenario does not load.
+[[nodiscard]] std::string scenario_fingerprint(const std::string& path);
+
+/// \brief Every scenario x variant x seed, in a fixed order, each scenario's
+///        files fingerprinted (scenario_fingerprint()).
+/// \throws std::invalid_argument from check_sweep_size(), before anything is
+///         allocated, or from scenario_fingerprint().
 [[nodiscard]] std::vector<EpisodeSpec> plan_episodes(
     const std::vector<std::pair<std::string, std::string>>& scenarios,  // name, path
     const Grid& grid);
@@ -91,6 +102,9 @@ struct Shard {
 struct EpisodeOutcome {
   EpisodeMetrics metrics;
   std::vector<StepRecord> steps;  ///< for the time plots and trajectory files
+  /// Every setting as the episode resolved it (episode_settings_table()),
+  /// recorded with the episode; empty when the runner does not say.
+  std::vector<std::pair<std::string, std::string>> settings;
 };
 
 /// \brief Runs one episode; must be deterministic given the spec and thread-safe.
