@@ -16,6 +16,12 @@ packages=(
   gnuplot-nox
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ -fsanitize=fuzzer (libFuzzer)
 )
+# --cluster: also what the sweep tests of ctest label `cluster` need (a
+# single-node Slurm cluster, GNU parallel). Not by default: on a machine with
+# systemd, Debian's slurm-wlm starts its daemons.
+if [ "${1:-}" = "--cluster" ]; then
+  packages+=(slurm-wlm munge parallel python3)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -180,6 +180,49 @@ TEST_F(SweepCli, MergeRefusesOtherSweepsAndConflictsAndNamesWhatIsMissing) {
 }
 
 
+TEST_F(SweepCli, DryRunListsThePartAndSlurmScriptWritesTheJobs) {
+  const std::string grid = sh(write("g.yaml", kShort + "seeds: 2\nvariants:\n  - {name: fast, set: {gain: 2}}\n"
+                                                       "  - {name: slow, set: {gain: 1}}\n").string());
+  const std::string sweep = "compare --scenarios dvd-one-hand dvd-static --grid " + grid;
+  // 8 episodes; part 2/3 runs those of index 1, 4, 7. Nothing is written.
+  const CommandRun dry = run(sweep + " --dry-run --shard 2/3");
+  ASSERT_EQ(dry.code, 0) << dry.err;
+  EXPECT_EQ(dry.out.substr(0, dry.out.find('\n')), "index,shard,scenario,variant,seed,id");
+  EXPECT_EQ(std::count(dry.out.begin(), dry.out.end(), '\n'), 4) << dry.out;
+  EXPECT_NE(dry.out.find("\n1,2/3,dvd-one-hand,fast,1,dvd-one-hand__fast__seed1__"), std::string::npos) << dry.out;
+  EXPECT_NE(dry.out.find("\n4,2/3,dvd-static,fast,0,"), std::string::npos) << dry.out;
+  EXPECT_NE(dry.out.find("\n7,2/3,dvd-static,slow,1,"), std::string::npos) << dry.out;
+  EXPECT_NE(dry.err.find("3 of 8 episodes listed"), std::string::npos) << dry.err;
+  // The job scripts, for an output folder whose name needs quoting.
+  const fs::path out = dir_ / "it's here";
+  const CommandRun slurm = run(sweep + " --jobs 3 --slurm-script 3 --out " + sh(out.string()));
+  ASSERT_EQ(slurm.code, 0) << slurm.err;
+  EXPECT_FALSE(fs::exists(out / "sweep.json"));
+  for (const char* name : {"sweep.sbatch", "merge.sbatch", "submit.sh"}) {
+    EXPECT_NE(fs::status(out / "slurm" / name).permissions() & fs::perms::owner_exec, fs::perms::none) << name;
+  }
+  const auto text = [&](const char* name) {
+    std::ifstream in(out / "slurm" / name);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string quoted = sh(out.string());
+  for (const std::string& part : {std::string("#SBATCH --array=1-3\n"), std::string("#SBATCH --cpus-per-task=3\n"),
+                                  std::string("--shard \"${SLURM_ARRAY_TASK_ID}/3\""),
+                                  std::string("--jobs \"${SLURM_CPUS_PER_TASK:-1}\""), std::string("--seeds 2"),
+                                  quoted + "/parts/\"${SLURM_ARRAY_TASK_ID}\"", std::string("dvd-static.yaml'")}) {
+    EXPECT_NE(text("sweep.sbatch").find(part), std::string::npos) << part << "\n" << text("sweep.sbatch");
+  }
+  for (const std::string& part : {quoted + "/parts/1 ", quoted + "/parts/3 ", "--out " + quoted}) {
+    EXPECT_NE(text("merge.sbatch").find(part), std::string::npos) << part << "\n" << text("merge.sbatch");
+  }
+  EXPECT_NE(text("submit.sh").find("--dependency=afterok:"), std::string::npos) << text("submit.sh");
+  // Usage errors.
+  expect_usage_error(sweep.substr(8) + " --slurm-script 0 --out " + sh(out.string()), {"--slurm-script", "1..1000"});
+  expect_usage_error(sweep.substr(8) + " --slurm-script 2 --shard 1/2 --out " + sh(out.string()), {"--shard"});
+  expect_usage_error(sweep.substr(8) + " --dry-run --slurm-script 2 --out " + sh(out.string()), {"--dry-run"});
+  expect_usage_error(sweep.substr(8), {"--out"});
+}
+
 TEST_F(SweepCli, SimulateOutIsNeverPastedIntoAShell) {
   const fs::path marker = dir_ / "marker";
   const fs::path out = dir_ / ("o'$(touch " + marker.string() + ")'\"`touch " + marker.string() + "`\"");
