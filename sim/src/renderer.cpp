@@ -188,6 +188,12 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index) c
 RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
                                const CameraIntrinsics& k, bool noise) const {
   RenderedFrame out;
+  render(wMc, frame_index, k, noise, out);
+  return out;
+}
+
+void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const CameraIntrinsics& k, bool noise,
+                      RenderedFrame& out) const {
   RgbdFrame& f = out.frame;
   f.timestamp = time_;
   f.intrinsics = k;
@@ -196,11 +202,26 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
   f.depth.assign(pixels, 0.0f);
   f.rgb.assign(3 * pixels, 0);
   out.labels.assign(pixels, kLabelNone);
-  std::vector<float> cos_incidence(pixels, 0.0f);
+  // Scratch kept by each thread that calls render, so a loop of frames
+  // reuses it. (The workers below use the caller's, through these references.)
+  thread_local std::vector<std::uint8_t> grazing_scratch;
+  thread_local std::vector<float> clean_scratch;
+  std::vector<std::uint8_t>& grazing = grazing_scratch;
+  std::vector<float>& clean = clean_scratch;
+  grazing.assign(pixels, 0);
   const SensorSettings& sensor = scenario_.sensor;
+  const float cos_grazing = static_cast<float>(std::cos(sensor.noise.grazing_deg * kDegToRad));
   const Eigen::Matrix3d R = wMc.linear();
   const Eigen::Vector3d o = wMc.translation();
 
+  // The ray of pixel (u, v) is R (x_u, y_v, 1) with x_u = (u - cx) / fx,
+  // y_v = (v - cy) / fy: the columns' products R.col(0) x_u are made once,
+  // and each pixel adds in the same order as the product would,
+  // (R.col(0) x_u + R.col(1) y_v) + R.col(2), so the rays are bit for bit
+  // those of the product.
+  std::vector<Eigen::Vector3d> column_term(static_cast<std::size_t>(k.width));
+  for (int u = 0; u < k.width; ++u) column_term[static_cast<std::size_t>(u)] = R.col(0) * ((u - k.cx) / k.fx);
+  const Eigen::Vector3d last = R.col(2);
   // Coherent rays of 8 neighbouring pixels are traced as one packet.
   auto render_rows = [&](int row0, int row1) {
     RTCIntersectContext context;
@@ -209,24 +230,29 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
     constexpr int kPacket = 8;
     alignas(32) int valid[kPacket];
     RTCRayHit8 rh;
+    // What Embree reads and never writes, set once.
+    for (int j = 0; j < kPacket; ++j) {
+      rh.ray.org_x[j] = static_cast<float>(o.x());
+      rh.ray.org_y[j] = static_cast<float>(o.y());
+      rh.ray.org_z[j] = static_cast<float>(o.z());
+      rh.ray.tnear[j] = static_cast<float>(sensor.min_depth);
+      rh.ray.mask[j] = 0xFFFFFFFFu;
+      rh.ray.time[j] = 0.0f;
+      rh.ray.flags[j] = 0;
+    }
+    const float tfar = static_cast<float>(sensor.max_depth);
     for (int v = row0; v < row1; ++v) {
+      const Eigen::Vector3d row_term = R.col(1) * ((v - k.cy) / k.fy);
       for (int u0 = 0; u0 < k.width; u0 += kPacket) {
         for (int j = 0; j < kPacket; ++j) {
           const int u = u0 + j;
           valid[j] = u < k.width ? -1 : 0;
           // Camera ray with unit Z, so the hit distance is the depth Z.
-          const Eigen::Vector3d d = R * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
-          rh.ray.org_x[j] = static_cast<float>(o.x());
-          rh.ray.org_y[j] = static_cast<float>(o.y());
-          rh.ray.org_z[j] = static_cast<float>(o.z());
+          const Eigen::Vector3d d = (column_term[static_cast<std::size_t>(std::min(u, k.width - 1))] + row_term) + last;
           rh.ray.dir_x[j] = static_cast<float>(d.x());
           rh.ray.dir_y[j] = static_cast<float>(d.y());
           rh.ray.dir_z[j] = static_cast<float>(d.z());
-          rh.ray.tnear[j] = static_cast<float>(sensor.min_depth);
-          rh.ray.tfar[j] = static_cast<float>(sensor.max_depth);
-          rh.ray.mask[j] = 0xFFFFFFFFu;
-          rh.ray.time[j] = 0.0f;
-          rh.ray.flags[j] = 0;
+          rh.ray.tfar[j] = tfar;
           rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect8(valid, impl_->scene, &context, &rh);
@@ -238,7 +264,7 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
           const Eigen::Vector3d d(rh.ray.dir_x[j], rh.ray.dir_y[j], rh.ray.dir_z[j]);
           const double c = std::abs(ng.normalized().dot(d.normalized()));
           f.depth[i] = rh.ray.tfar[j];
-          cos_incidence[i] = static_cast<float>(c);
+          grazing[i] = static_cast<float>(c) < cos_grazing ? 1 : 0;
           out.labels[i] = impl_->labels[geom];
           const Eigen::Vector3f colour = scenario_.bodies[geom].colour;
           const float shade = static_cast<float>(0.35 + 0.65 * c);
@@ -262,21 +288,24 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
     for (auto& t : pool) t.join();
   };
   in_parallel(render_rows);
-  if (noise) add_noise(f, cos_incidence, sensor.noise, frame_index, in_parallel);
+  if (noise) add_noise(f, grazing, clean, sensor.noise, frame_index, in_parallel);
   // Sensors and recordings store depth as 16-bit counts: so does the
   // simulated sensor, so that a recorded episode replays bit for bit.
-  for (float& z : f.depth) z = depth_from_units(depth_to_units(z, kTumDepthFactor), kTumDepthFactor);
-  return out;
+  in_parallel([&](int row0, int row1) {
+    const auto end = f.depth.begin() + static_cast<std::ptrdiff_t>(f.index(0, row1));
+    for (auto z = f.depth.begin() + static_cast<std::ptrdiff_t>(f.index(0, row0)); z != end; ++z) {
+      *z = depth_from_units(depth_to_units(*z, kTumDepthFactor), kTumDepthFactor);
+    }
+  });
 }
 
-void Renderer::add_noise(RgbdFrame& f, const std::vector<float>& cos_incidence, const NoiseModel& m,
-                         long frame_index, const ParallelRows& in_parallel) const {
+void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing, std::vector<float>& clean,
+                         const NoiseModel& m, long frame_index, const ParallelRows& in_parallel) const {
   const CameraIntrinsics& k = f.intrinsics;
 
   // A generator per row, seeded from (scenario seed, frame, row): the same
   // frame whatever the thread count.
-  const float cos_grazing = static_cast<float>(std::cos(m.grazing_deg * kDegToRad));
-  const std::vector<float> clean = f.depth;
+  clean = f.depth;
   in_parallel([&](int row0, int row1) {
     for (int v = row0; v < row1; ++v) {
       std::mt19937_64 rng(scenario_.seed * 0x9E3779B97F4A7C15ull ^
@@ -296,7 +325,7 @@ void Renderer::add_noise(RgbdFrame& f, const std::vector<float>& cos_incidence, 
         }
         const double noise_z = gauss(rng) * m.depth_sigma * z * z;
         const double drop = uni(rng);
-        if (cos_incidence[i] < cos_grazing || (edge && drop < m.edge_dropout)) {
+        if (grazing[i] != 0 || (edge && drop < m.edge_dropout)) {
           f.depth[i] = 0.0f;
         } else {
           f.depth[i] = static_cast<float>(z + noise_z);

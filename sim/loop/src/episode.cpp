@@ -153,6 +153,8 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   // Commands on their way to the robot, oldest first.
   std::deque<vpColVector> in_flight(static_cast<std::size_t>(setup.latency), vpColVector(6, 0.0));
   EpisodeOutcome outcome;
+  const sim::SensorSettings& sensor = renderer.scenario().sensor;
+  sim::RenderedFrame rendered;  // each frame is rendered into the memory of the one before
   for (long k = 0; k < steps; ++k) {
     StepRecord rec;
     rec.time = static_cast<double>(k) * dt;
@@ -162,7 +164,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 
     auto start = Clock::now();
     renderer.set_time(rec.time);
-    sim::RenderedFrame rendered = renderer.render(wMc, k);
+    renderer.render(wMc, k, sensor.intrinsics, sensor.noise.enabled, rendered);
     rendered.frame.timestamp = rec.time;
     rec.times.render = seconds_since(start);
 

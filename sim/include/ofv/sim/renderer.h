@@ -67,6 +67,11 @@ class Renderer {
   /// \brief The same with other intrinsics and noise switched on or off.
   [[nodiscard]] RenderedFrame render(const Eigen::Isometry3d& wMc, long frame_index,
                                      const CameraIntrinsics& intrinsics, bool noise) const;
+  /// \brief The same into `out`, reusing its images' memory: a loop that
+  ///        renders frame after frame into one RenderedFrame allocates (and
+  ///        has the system clear) no memory after its first frame.
+  void render(const Eigen::Isometry3d& wMc, long frame_index, const CameraIntrinsics& intrinsics, bool noise,
+              RenderedFrame& out) const;
 
   /// \brief Object ground truth seen from a camera at `wMc` (r_sphere for the occluder count).
   [[nodiscard]] ObjectTruth truth(const Eigen::Isometry3d& wMc, double r_sphere) const;
@@ -87,9 +92,11 @@ class Renderer {
 
  private:
   using ParallelRows = std::function<void(const std::function<void(int, int)>&)>;
-  // Depth noise and dropouts (NoiseModel), per row from (seed, frame, row).
-  void add_noise(RgbdFrame& f, const std::vector<float>& cos_incidence, const NoiseModel& m, long frame_index,
-                 const ParallelRows& in_parallel) const;
+  // Depth noise and dropouts (NoiseModel), per row from (seed, frame, row);
+  // `grazing`: 1 where the ray meets the surface more obliquely than the
+  // model's grazing angle; `clean`: scratch for the depth before noise.
+  void add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing, std::vector<float>& clean,
+                 const NoiseModel& m, long frame_index, const ParallelRows& in_parallel) const;
 
   struct Impl;
   Scenario scenario_;
