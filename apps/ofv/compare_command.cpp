@@ -108,7 +108,12 @@ Command add_compare_command(CLI::App& app) {
                 (void)shard(episodes, part.k, part.n);  // checks K/N
                 if (slurm->count() > 0) {
                   SlurmSweep job;
-                  job.ofv = fs::read_symlink("/proc/self/exe").string();
+                  std::error_code error;
+                  job.ofv = fs::read_symlink("/proc/self/exe", error).string();
+                  if (error) {
+                    throw std::invalid_argument("--slurm-script: cannot tell where this ofv program is "
+                                                "(/proc/self/exe: " + error.message() + ")");
+                  }
                   for (const auto& s : scenarios) job.scenarios.push_back(fs::absolute(s.second).lexically_normal().string());
                   job.grid = fs::absolute(opt->grid).lexically_normal().string();
                   job.seeds = grid.seeds;
