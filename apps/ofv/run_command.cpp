@@ -6,6 +6,9 @@
 #include "ofv/servo/robot_loop.h"
 #include "ofv/servo/target_pose.h"
 #include "ofv/sources/open_source.h"
+#if defined(OFV_HAVE_DISPLAY)
+#include "ofv/display/live_display.h"
+#endif
 
 #include <visp3/core/vpConfig.h>
 #include <visp3/core/vpPoseVector.h>
@@ -151,6 +154,7 @@ Command add_run_command(CLI::App& app) {
     std::string emc;
     std::vector<std::string> sets;
     bool dry_run = false;
+    bool display = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("run", "Run the closed loop on a robot and a sensor, a recording, or a live simulation");
@@ -167,6 +171,12 @@ Command add_run_command(CLI::App& app) {
       ->type_name("NAME=VALUE");
   sub->add_flag("--dry-run", opt->dry_run,
                 "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
+#if defined(OFV_HAVE_DISPLAY)
+  sub->add_flag("--display", opt->display,
+                "Show the loop live in ViSP windows (camera image with supervoxels, occluders, tracks and the feature; "
+                "scene view; velocity and feature error curves). Left click: pause (the robot is sent a zero velocity "
+                "first) and resume; right click or q: stop, as SIGTERM does. Needs an X display (exit 2 without one)");
+#endif
   sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits (0). The object is picked in the first frame "
               "(the cluster nearest the image centre); when it is lost, or a frame is stale (older than stale_timeout "
               "after the previous one, or not after it), the robot stops. An error mid-run (the source, perception or "
@@ -184,6 +194,9 @@ Command add_run_command(CLI::App& app) {
             EpisodeSetup setup;
             std::unique_ptr<FrameSource> source;
             std::unique_ptr<CameraRobot> robot;
+#if defined(OFV_HAVE_DISPLAY)
+            std::unique_ptr<LiveDisplay> display;
+#endif
             try {
               std::vector<std::pair<std::string, std::string>> settings;
               for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
@@ -209,21 +222,42 @@ Command add_run_command(CLI::App& app) {
                 }
                 source = open_source(opt->source, 1.0f);
               }
+#if defined(OFV_HAVE_DISPLAY)
+              if (opt->display) {
+                LiveDisplayOptions options;
+                options.title = "ofv run";
+                options.r_sphere = setup.loop.estimator.resolve().r_sphere;
+                display = std::make_unique<LiveDisplay>(options);
+                // A pause holds the robot: zero velocity, as at the end of a run
+                // (the rehearsal's arm is inside ofv::rehearse: it keeps its command).
+                if (robot && (!opt->dry_run || !real)) {
+                  display->set_pause_hook([&robot] { (void)robot->step(vpColVector(6, 0.0), 0.0); });
+                }
+              }
+#endif
             } catch (const std::exception& e) {  // sources report unreadable paths as runtime errors: here they are bad input
               std::cerr << "ofv run: " << e.what() << '\n';
               return kUsage;
             }
             try {
               CommandLines lines(opt->dry_run);
+              bool user_quit = false;  // the display's quit, not a signal
               const auto print = [&](const RobotLoopFrame& f) {
                 lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
                             to_string(f.step->safety), f.step->tracks);
+#if defined(OFV_HAVE_DISPLAY)
+                // The user ending the run stops it as SIGTERM does.
+                if (display && !display->observe(f)) {
+                  user_quit = true;
+                  g_stop = 1;
+                }
+#endif
               };
               if (simulated) {
                 const EpisodeOutcome outcome = rehearse(setup, &g_stop, print);
                 lines.close();
                 std::cout << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
-                          << (g_stop ? ", stopped" : "") << '\n'
+                          << (g_stop ? (user_quit ? ", stopped from the display" : ", stopped") : "") << '\n'
                           << episode_summary(outcome.metrics);
                 return kOk;
               }
@@ -235,7 +269,7 @@ Command add_run_command(CLI::App& app) {
               const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
               lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
-                        << (summary.stopped ? ", stopped by a signal" : "") << '\n';
+                        << (summary.stopped ? (user_quit ? ", stopped from the display" : ", stopped by a signal") : "") << '\n';
               return kOk;
             } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims (after the stop line)
               std::cerr << "ofv run: " << e.what() << '\n';
