@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <thread>
 
 namespace ofv {
@@ -83,7 +84,17 @@ std::string format(const char* fmt, double a, double b, double c, double d) {
 
 struct LiveDisplay::Impl {
   LiveDisplayOptions options;
+  // handle() may come from another thread (a front end, a test) while show() waits.
+  mutable std::mutex mutex;
   DisplayControl control;
+  DisplayControl::State state() const {
+    const std::lock_guard<std::mutex> lock(mutex);
+    return control.state();
+  }
+  void handle(DisplayControl::Event e) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    control.handle(e);
+  }
   std::function<void()> pause_hook;
   vpImage<vpRGBa> camera;
   vpImage<vpRGBa> scene;
@@ -118,14 +129,14 @@ struct LiveDisplay::Impl {
     auto events = [&](const auto& image) {
       vpImagePoint ip;
       vpMouseButton::vpMouseButtonType button;
-      while (control.state() != DisplayControl::State::Quit && vpDisplay::getClick(image, ip, button, false)) {
-        control.handle(button == vpMouseButton::button3   ? DisplayControl::Event::RightClick
+      while (state() != DisplayControl::State::Quit && vpDisplay::getClick(image, ip, button, false)) {
+        handle(button == vpMouseButton::button3   ? DisplayControl::Event::RightClick
                        : button == vpMouseButton::button2 ? DisplayControl::Event::MiddleClick
                                                           : DisplayControl::Event::LeftClick);
       }
       std::string key;
-      while (control.state() != DisplayControl::State::Quit && vpDisplay::getKeyboardEvent(image, key, false)) {
-        if (const auto e = DisplayControl::key_event(key)) control.handle(*e);
+      while (state() != DisplayControl::State::Quit && vpDisplay::getKeyboardEvent(image, key, false)) {
+        if (const auto e = DisplayControl::key_event(key)) handle(*e);
       }
     };
     if (camera_window) events(camera);
@@ -202,10 +213,10 @@ struct LiveDisplay::Impl {
                                  feature_error[5] * feature_error[5]);
       vpDisplay::displayText(camera, 30, 6, format("s: x %+.3f  y %+.3f  rho-R %+.3f  |f| %.3f", feature_error[0],
                                                    feature_error[1], feature_error[2], f), kCurrent);
-      vpDisplay::displayText(camera, 46, 6, "s*: 0 (C centred, on the sphere, on the target's ray)", kDesired);
+      vpDisplay::displayText(camera, 46, 6, "s*: 0 (C centred, on the sphere, on the target ray)", kDesired);
     }
     vpDisplay::displayText(camera, static_cast<int>(camera.getHeight()) - 8, 6,
-                           control.state() == DisplayControl::State::Paused
+                           state() == DisplayControl::State::Paused
                                ? "PAUSED - left click: resume, right click: end"
                                : "left click: pause, right click or q: end",
                            kText);
@@ -293,8 +304,10 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
       m.error_graph = g;
       m.plot->initGraph(m.velocity_graph, 6);
       m.plot->setTitle(m.velocity_graph, "camera velocity [m/s, rad/s]");
+      m.plot->initRange(m.velocity_graph, 0.0, 1.0, -0.6, 0.6);  // widened as the curves need
       m.plot->initGraph(m.error_graph, 6);
       m.plot->setTitle(m.error_graph, "feature error s - s*");
+      m.plot->initRange(m.error_graph, 0.0, 1.0, -0.2, 0.2);
       const char* v_names[6] = {"vx", "vy", "vz", "wx", "wy", "wz"};
       const char* e_names[6] = {"x", "y", "rho-R", "fx", "fy", "fz"};
       const vpColor colours[6] = {vpColor::red, vpColor::green, vpColor::blue, vpColor::orange, vpColor::purple,
@@ -317,7 +330,7 @@ LiveDisplay::~LiveDisplay() = default;
 
 bool LiveDisplay::show(const DisplayInput& in) {
   Impl& m = *impl_;
-  if (m.control.state() == DisplayControl::State::Quit) return false;
+  if (m.state() == DisplayControl::State::Quit) return false;
   m.path.push_back(in.wMc.translation());
   const Eigen::Vector3d* centroid = nullptr;
   if (in.step && in.step->estimate) {
@@ -339,16 +352,16 @@ bool LiveDisplay::show(const DisplayInput& in) {
     if (m.last_shown) std::this_thread::sleep_until(*m.last_shown + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period));
   }
   m.poll();
-  if (m.control.state() == DisplayControl::State::Paused) {
+  if (m.state() == DisplayControl::State::Paused) {
     if (m.pause_hook) m.pause_hook();
     m.draw_camera(in, centroid, target);  // with the pause line
-    while (m.control.state() == DisplayControl::State::Paused) {
+    while (m.state() == DisplayControl::State::Paused) {
       std::this_thread::sleep_for(std::chrono::milliseconds(30));
       m.poll();
     }
   }
   m.last_shown = std::chrono::steady_clock::now();
-  return m.control.state() != DisplayControl::State::Quit;
+  return m.state() != DisplayControl::State::Quit;
 }
 
 bool LiveDisplay::observe(const StepRecord& record, const StepDetail& detail) {
@@ -380,8 +393,11 @@ bool LiveDisplay::observe(const RobotLoopFrame& f) {
 }
 
 void LiveDisplay::set_pause_hook(std::function<void()> hook) { impl_->pause_hook = std::move(hook); }
-DisplayControl::State LiveDisplay::handle(DisplayControl::Event event) { return impl_->control.handle(event); }
-DisplayControl::State LiveDisplay::state() const { return impl_->control.state(); }
+DisplayControl::State LiveDisplay::handle(DisplayControl::Event event) {
+  impl_->handle(event);
+  return impl_->state();
+}
+DisplayControl::State LiveDisplay::state() const { return impl_->state(); }
 
 void LiveDisplay::grab_camera(vpImage<vpRGBa>& image) const {
 #if defined(VISP_HAVE_DISPLAY)
@@ -395,6 +411,16 @@ void LiveDisplay::grab_scene(vpImage<vpRGBa>& image) const {
 #if defined(VISP_HAVE_DISPLAY)
   if (impl_->scene_window) {
     vpDisplay::getImage(impl_->scene, image);
+    return;
+  }
+#endif
+  image = vpImage<vpRGBa>();
+}
+
+void LiveDisplay::grab_plot(vpImage<vpRGBa>& image) const {
+#if defined(VISP_HAVE_DISPLAY)
+  if (impl_->plot) {
+    vpDisplay::getImage(impl_->plot->I, image);
     return;
   }
 #endif

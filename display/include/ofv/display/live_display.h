@@ -141,6 +141,8 @@ class LiveDisplay {
   void grab_camera(vpImage<vpRGBa>& image) const;
   /// \brief The scene window's pixels as shown; empty without a scene window.
   void grab_scene(vpImage<vpRGBa>& image) const;
+  /// \brief The curves window's pixels as shown; empty without it.
+  void grab_plot(vpImage<vpRGBa>& image) const;
   /// \brief Where the last frame's centroid projected in the camera image [px], if in front.
   [[nodiscard]] std::optional<Eigen::Vector2d> last_centroid_pixel() const;
   /// \brief The sphere feature's error s - s* of the last frame: (x, y, rho - R, f) (empty when undefined).
