@@ -202,10 +202,13 @@ struct LiveDisplay::Impl {
         }
       }
     }
-    const StepStatus status = in.status ? *in.status : in.step ? in.step->status : StepStatus::ObjectLost;
     std::string head = format("t=%.2f s", in.time, 0, 0, 0);
     if (in.visible_fraction) head += format("  visible %.3f", *in.visible_fraction, 0, 0, 0);
-    head += std::string("  ") + to_string(status);
+    if (in.status) {
+      head += std::string("  ") + to_string(*in.status);
+    } else if (in.step) {
+      head += std::string("  ") + to_string(in.step->status);
+    }
     if (in.step && in.step->safety != SafetyAction::None) head += std::string("  safety: ") + to_string(in.step->safety);
     vpDisplay::displayText(camera, 14, 6, head, kText);
     if (feature_error.size() == 6) {
@@ -236,7 +239,11 @@ struct LiveDisplay::Impl {
     state.wMc = in.wMc;
     if (centroid) state.centroid = *centroid;
     state.visible_fraction = in.visible_fraction;
-    state.status = in.status ? *in.status : in.step ? in.step->status : StepStatus::ObjectLost;
+    if (in.status) {
+      state.status = in.status;
+    } else if (in.step) {
+      state.status = in.step->status;
+    }
     state.problem = in.problem;
     state.step = in.step;
     state.target = target;

@@ -100,7 +100,7 @@ struct DisplayInput {
   std::optional<Eigen::Vector3d> centroid;
   std::optional<Eigen::Vector3d> target;   ///< the view driven to, when there is no step
   std::optional<double> visible_fraction;  ///< the true visible fraction (simulation only)
-  std::optional<StepStatus> status;        ///< default: the step's
+  std::optional<StepStatus> status;        ///< default: the step's (none without a step)
   /// The camera twist sent (v, w) [m/s, rad/s]; default: the step's velocity.
   std::optional<vpColVector> velocity;
 };

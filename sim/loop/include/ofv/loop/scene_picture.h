@@ -35,7 +35,7 @@ struct SceneState {
   /// true centroid; elsewhere the last one known).
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::optional<double> visible_fraction;  ///< the true visible fraction (simulation only)
-  StepStatus status = StepStatus::ObjectLost;
+  std::optional<StepStatus> status;       ///< the loop's status (none: a loop of the caller's own)
   const ViewProblem* problem = nullptr;  ///< supervoxels and occluders; nullptr when lost
   const LoopStep* step = nullptr;        ///< estimate, target, tracks; nullptr when none
   /// The target when there is no step (a caller's own servo loop).
@@ -49,7 +49,7 @@ struct SceneState {
  *        target the controller follows where it differs from tf (magenta),
  *        each confirmed occluder track as an orange arrow to where it will
  *        be in 0.5 s with its id, and a line of text (time, visible
- *        fraction when known, status).
+ *        fraction and status when known).
  * \param path the camera positions so far (world) [m].
  */
 [[nodiscard]] RgbPicture scene_picture(const SceneState& state, const std::vector<Eigen::Vector3d>& path,
