@@ -294,7 +294,10 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
     throw DisplayUnavailable("--display: no display (DISPLAY is not set); run without --display, or under xvfb-run");
   }
   try {
-    m.open_camera(640, 480);
+    // The camera window opens at the first frame, at the frame's size (a
+    // window made again is a new window); the others open here, and so
+    // check the connection. With neither, the camera window opens here.
+    if (!options.scene && !options.plot) m.open_camera(640, 480);
     if (options.scene) {
       m.scene.resize(480, 640, vpRGBa(30, 30, 30));
       m.scene_window = std::make_unique<WindowDisplay>();

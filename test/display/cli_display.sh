@@ -4,6 +4,7 @@
 #   same-metrics  (under Xvfb) the episode's metrics and trajectory are those without --display
 #   quit          (under Xvfb, xdotool) a left click pauses, another resumes, a right click ends the
 #                 episode early: exit 0, files written, metrics.json marked ended_by_user
+#   run-quit      (under Xvfb, xdotool) a right click stops `ofv run` as SIGTERM does
 set -u
 mode=$1 ofv=$2 work=$3
 mkdir -p "$work"
@@ -53,8 +54,8 @@ quit)
   "$ofv" simulate dvd-one-hand --set duration=20 --perception ground-truth --no-pictures --display \
     --out "$work/quit" >"$work/quit.out" 2>&1 &
   pid=$!
-  win=$(timeout 20 "$xdotool" search --sync --name "ofv simulate dvd-one-hand: camera" | head -1)
-  [ -n "$win" ] || { kill $pid; fail "no camera window"; }
+  win=$(timeout 20 "$xdotool" search --sync --onlyvisible --name "ofv simulate dvd-one-hand: scene" | head -1)
+  [ -n "$win" ] || { kill $pid; fail "no scene window"; }
   shown=$(date +%s%N)
   sleep 1
   "$xdotool" mousemove --window "$win" 40 40 click 1   # pause
@@ -79,6 +80,39 @@ quit)
   awk -v d="$(value duration_s)" -v w="$wall" 'BEGIN {exit !(d > 0.2 && d * 1000 < w - 1500)}' ||
     fail "the pause did not hold the episode"
   [ "$(wc -l < "$work/quit/trajectory.csv")" -eq $(( $(value steps) + 1 )) ] || fail "trajectory.csv rows"
+  ;;
+run-quit)
+  # `ofv run --display` on a recording: a left click pauses the run (the
+  # robot is sent a zero velocity) and no command follows while it is
+  # paused; a right click then stops it through the stop path of SIGTERM:
+  # the last command line is the stop, exit 0.
+  xdotool=${OFV_XDOTOOL:-$(command -v xdotool)}
+  case "$xdotool" in ""|*NOTFOUND) echo "xdotool not found: skipped"; exit 77 ;; esac
+  rec="$work/recording"
+  [ -f "$rec/groundtruth.txt" ] || "$ofv" record dvd-one-hand --format tum --out "$rec" >/dev/null || fail "ofv record"
+  frames=$(grep -vc '^#' "$rec/rgb.txt")
+  "$ofv" run --robot camera --source "$rec" --dry-run --display >"$work/run.jsonl" 2>"$work/run.err" &
+  pid=$!
+  # The scene window opens before the first frame: the click waits in its queue.
+  win=$(timeout 20 "$xdotool" search --sync --onlyvisible --name "ofv run: scene" | head -1)
+  [ -n "$win" ] || { kill $pid; fail "no scene window"; }
+  "$xdotool" mousemove --window "$win" 40 40 click 1   # pause
+  sleep 0.5
+  paused_at=$(wc -l < "$work/run.jsonl")
+  sleep 2
+  kill -0 $pid 2>/dev/null || fail "the run ended while paused"
+  [ "$(wc -l < "$work/run.jsonl")" -eq "$paused_at" ] || fail "commands went on while paused"
+  "$xdotool" mousemove --window "$win" 40 40 click 3   # stop
+  wait $pid
+  rc=$?
+  cat "$work/run.err"
+  [ $rc -eq 0 ] || fail "exit $rc"
+  grep -q "stopped from the display" "$work/run.err" || fail "not stopped from the display"
+  tail -1 "$work/run.jsonl" | grep -q '"status": "stop"' || fail "the last line is not the stop"
+  lines=$(wc -l < "$work/run.jsonl")
+  echo "paused after $paused_at command lines; $lines (the stop included) of a $frames-frame recording"
+  [ "$lines" -eq $((paused_at + 1)) ] || fail "commands after the pause other than the stop"
+  [ "$lines" -lt "$frames" ] || fail "the run was not cut short"
   ;;
 *) fail "unknown mode $mode" ;;
 esac
