@@ -175,7 +175,8 @@ Command add_run_command(CLI::App& app) {
   sub->add_flag("--display", opt->display,
                 "Show the loop live in ViSP windows (camera image with supervoxels, occluders, tracks and the feature; "
                 "scene view; velocity and feature error curves). Left click: pause (the robot is sent a zero velocity "
-                "first) and resume; right click or q: stop, as SIGTERM does. Needs an X display (exit 2 without one)");
+                "first; not in a sim: rehearsal, whose threaded arm would run on) and resume; right click or q: stop, "
+                "as SIGTERM does. Needs an X display (exit 2 without one)");
 #endif
   sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits (0). The object is picked in the first frame "
               "(the cluster nearest the image centre); when it is lost, or a frame is stale (older than stale_timeout "
@@ -227,9 +228,11 @@ Command add_run_command(CLI::App& app) {
                 LiveDisplayOptions options;
                 options.title = "ofv run";
                 options.r_sphere = setup.loop.estimator.resolve().r_sphere;
+                // A pause holds the robot: zero velocity, as at the end of a run.
+                // The rehearsal's arm is inside ofv::rehearse, out of reach: it
+                // would keep its command, so a rehearsal has no pause.
+                options.pause = !simulated;
                 display = std::make_unique<LiveDisplay>(options);
-                // A pause holds the robot: zero velocity, as at the end of a run
-                // (the rehearsal's arm is inside ofv::rehearse: it keeps its command).
                 if (robot && (!opt->dry_run || !real)) {
                   display->set_pause_hook([&robot] { (void)robot->step(vpColVector(6, 0.0), 0.0); });
                 }

@@ -63,7 +63,7 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_flag("--display", opt->display,
                 "Show the loop live in ViSP windows: the camera image with supervoxels, occluders, tracks and the "
                 "feature, the scene view, and curves (visible fraction, velocity, feature error). Left click: pause "
-                "and resume; right click or q: end the episode (its files are written, marked ended_by_user). Needs "
+                "and resume (not with --real-time); right click or q: end the episode (its files are written, marked ended_by_user). Needs "
                 "an X display (exit 2 without one)");
   sub->add_option("--display-speed", opt->display_speed,
                   "With --display: frames shown at this multiple of the scenario's rate (1 = real time, 0 = as fast "
@@ -97,8 +97,10 @@ Command add_simulate_command(CLI::App& app) {
                 options.title = "ofv simulate " + setup.scenario.name;
                 options.r_sphere = setup.loop.estimator.resolve().r_sphere;
                 options.ground_truth = true;
-                // The threaded arms already run in wall-clock time.
+                // The threaded arms already run in wall-clock time, and run on
+                // while the observer waits: no pause with --real-time.
                 options.pace_rate = setup.real_time ? 0.0 : opt->display_speed * setup.scenario.rate;
+                options.pause = !setup.real_time;
                 display = std::make_unique<LiveDisplay>(options);
               }
             } catch (const DisplayUnavailable& e) {

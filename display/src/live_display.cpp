@@ -36,7 +36,7 @@ DisplayControl::State DisplayControl::handle(Event event) {
     case Event::LeftClick:
     case Event::MiddleClick:
     case Event::PauseKey:
-      state_ = state_ == State::Running ? State::Paused : State::Running;
+      if (pausable_) state_ = state_ == State::Running ? State::Paused : State::Running;
       break;
     case Event::RightClick:
     case Event::QuitKey:
@@ -228,7 +228,8 @@ struct LiveDisplay::Impl {
     vpDisplay::displayText(camera, static_cast<int>(camera.getHeight()) - 8, 6,
                            state() == DisplayControl::State::Paused
                                ? "PAUSED - left click: resume, right click: end"
-                               : "left click: pause, right click or q: end",
+                               : options.pause ? "left click: pause, right click or q: end"
+                                               : "right click or q: end (no pause here)",
                            kText);
     vpDisplay::flush(camera);
 #else
@@ -283,6 +284,7 @@ struct LiveDisplay::Impl {
 LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.options = options;
+  m.control = DisplayControl(options.pause);
   if (!(options.r_sphere > 0.0) || !std::isfinite(options.r_sphere)) {
     throw std::invalid_argument("display: r_sphere must be a positive length, not " + std::to_string(options.r_sphere));
   }

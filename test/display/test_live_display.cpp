@@ -41,6 +41,12 @@ TEST(DisplayControl, RightClickOrQuitKeyEndsFromEitherStateForGood) {
   }
 }
 
+TEST(DisplayControl, WithoutPauseOnlyQuitChangesTheState) {
+  DisplayControl c(/*pausable=*/false);
+  for (const Event e : {Event::LeftClick, Event::MiddleClick, Event::PauseKey}) EXPECT_EQ(c.handle(e), State::Running);
+  EXPECT_EQ(c.handle(Event::QuitKey), State::Quit);
+}
+
 TEST(DisplayControl, KeysMapToEvents) {
   EXPECT_EQ(DisplayControl::key_event("q"), Event::QuitKey);
   EXPECT_EQ(DisplayControl::key_event("\x1b"), Event::QuitKey);

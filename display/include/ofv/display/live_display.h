@@ -52,10 +52,12 @@ class DisplayUnavailable : public std::runtime_error {
  * \brief The live display's state machine: what a click or a key does.
  *
  * Running ⇄ Paused on a left or middle click, space or p; Quit on a right
- * click, q or Escape, from either state. Quit is final.
+ * click, q or Escape, from either state. Quit is final. Without pause (a run
+ * whose robot a pause could not hold) the pause events change nothing.
  */
 class DisplayControl {
  public:
+  explicit DisplayControl(bool pausable = true) : pausable_(pausable) {}
   enum class State { Running, Paused, Quit };
   enum class Event {
     LeftClick,
@@ -71,6 +73,7 @@ class DisplayControl {
   [[nodiscard]] static std::optional<Event> key_event(const std::string& key);
 
  private:
+  bool pausable_ = true;
   State state_ = State::Running;
 };
 
@@ -83,6 +86,11 @@ struct LiveDisplayOptions {
   /// Wall-clock frames per second at most (the scenario's rate × a speed
   /// factor); 0: as fast as the loop runs.
   double pace_rate = 0.0;
+  /// A click pauses. false where a pause cannot hold the robot: the loop
+  /// runs inside a library call whose robot the caller cannot reach (the
+  /// threaded arm of ofv::rehearse or of a real-time episode keeps its last
+  /// velocity while its observer waits).
+  bool pause = true;
   bool scene = true;  ///< open the scene view window
   bool plot = true;   ///< open the vpPlot window
 };
