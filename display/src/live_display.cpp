@@ -30,6 +30,10 @@
 
 namespace ofv {
 
+namespace detail {
+bool x11_connects(const char* name);  // x11_check.cpp (Xlib's macros stay there)
+}  // namespace detail
+
 DisplayControl::State DisplayControl::handle(Event event) {
   if (state_ == State::Quit) return state_;
   switch (event) {
@@ -295,6 +299,13 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
   if (display == nullptr || *display == '\0') {
     throw DisplayUnavailable("--display: no display (DISPLAY is not set); run without --display, or under xvfb-run");
   }
+#if defined(VISP_HAVE_X11)
+  // The connection first, by itself: vpDisplayX leaks its colour table when
+  // it cannot connect (ViSP 3.5), which the sanitizer build reports.
+  if (!detail::x11_connects(display)) {
+    throw DisplayUnavailable(std::string("--display: cannot connect to the X display ") + display);
+  }
+#endif
   try {
     // The camera window opens at the first frame, at the frame's size (a
     // window made again is a new window); the others open here, and so

@@ -62,7 +62,11 @@ class DisplayEnv {
     if (const char* d = std::getenv("DISPLAY")) saved_ = d;
   }
   ~DisplayEnv() {
-    if (!saved_.empty()) setenv("DISPLAY", saved_.c_str(), 1);
+    if (saved_.empty()) {
+      unsetenv("DISPLAY");
+    } else {
+      setenv("DISPLAY", saved_.c_str(), 1);
+    }
   }
   DisplayEnv(const DisplayEnv&) = delete;
   DisplayEnv& operator=(const DisplayEnv&) = delete;
