@@ -72,11 +72,13 @@ const vpColor kCurrent(0, 255, 0);    // s: the projection of C
 const vpColor kDesired(255, 255, 0);  // s*: the image centre
 const vpColor kText(255, 255, 255);
 
-std::optional<vpImagePoint> project(const Eigen::Isometry3d& cMw, const CameraIntrinsics& k, const Eigen::Vector3d& w) {
+std::optional<vpImagePoint> project(const Eigen::Isometry3d& cMw, const CameraIntrinsics& k,
+                                    const Eigen::Vector3d& w) {
   const Eigen::Vector3d c = cMw * w;
   if (!(c.z() > 1e-3)) return std::nullopt;
   const double u = k.fx * c.x() / c.z() + k.cx, v = k.fy * c.y() / c.z() + k.cy;
-  if (!std::isfinite(u) || !std::isfinite(v) || std::abs(u) > 1e5 || std::abs(v) > 1e5) return std::nullopt;
+  if (!std::isfinite(u) || !std::isfinite(v) || std::abs(u) > 1e5 || std::abs(v) > 1e5)
+    return std::nullopt;
   return vpImagePoint(v, u);
 }
 
@@ -135,13 +137,15 @@ struct LiveDisplay::Impl {
     auto events = [&](const auto& image) {
       vpImagePoint ip;
       vpMouseButton::vpMouseButtonType button;
-      while (state() != DisplayControl::State::Quit && vpDisplay::getClick(image, ip, button, false)) {
+      while (state() != DisplayControl::State::Quit &&
+             vpDisplay::getClick(image, ip, button, false)) {
         handle(button == vpMouseButton::button3   ? DisplayControl::Event::RightClick
-                       : button == vpMouseButton::button2 ? DisplayControl::Event::MiddleClick
-                                                          : DisplayControl::Event::LeftClick);
+               : button == vpMouseButton::button2 ? DisplayControl::Event::MiddleClick
+                                                  : DisplayControl::Event::LeftClick);
       }
       std::string key;
-      while (state() != DisplayControl::State::Quit && vpDisplay::getKeyboardEvent(image, key, false)) {
+      while (state() != DisplayControl::State::Quit &&
+             vpDisplay::getKeyboardEvent(image, key, false)) {
         if (const auto e = DisplayControl::key_event(key)) handle(*e);
       }
     };
@@ -151,14 +155,17 @@ struct LiveDisplay::Impl {
 #endif
   }
 
-  void draw_camera(const DisplayInput& in, const Eigen::Vector3d* centroid, const std::optional<Eigen::Vector3d>& target) {
+  void draw_camera(const DisplayInput& in, const Eigen::Vector3d* centroid,
+                   const std::optional<Eigen::Vector3d>& target) {
 #if defined(VISP_HAVE_DISPLAY)
     const CameraIntrinsics k = in.frame ? in.frame->intrinsics : in.intrinsics;
     open_camera(static_cast<unsigned>(k.width), static_cast<unsigned>(k.height));
-    if (in.frame && in.frame->rgb.size() == static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height) * 3) {
+    if (in.frame && in.frame->rgb.size() == static_cast<std::size_t>(k.width) *
+                                                static_cast<std::size_t>(k.height) * 3) {
       const std::uint8_t* p = in.frame->rgb.data();
       vpRGBa* q = camera.bitmap;
-      for (std::size_t i = 0, n = camera.getSize(); i < n; ++i, p += 3) q[i] = vpRGBa(p[0], p[1], p[2]);
+      for (std::size_t i = 0, n = camera.getSize(); i < n; ++i, p += 3)
+        q[i] = vpRGBa(p[0], p[1], p[2]);
     } else {
       camera = vpRGBa(70, 70, 70);
     }
@@ -173,7 +180,9 @@ struct LiveDisplay::Impl {
     if (in.problem) {
       for (Eigen::Index i = 0; i < in.problem->occluders.cols(); ++i) {
         const auto a = project(cMw, k, in.problem->occluders.col(i));
-        if (a && inside(*a, 2)) vpImageDraw::drawRectangle(camera, vpRect(a->get_u() - 1, a->get_v() - 1, 3, 3), kOccluder, true);
+        if (a && inside(*a, 2))
+          vpImageDraw::drawRectangle(camera, vpRect(a->get_u() - 1, a->get_v() - 1, 3, 3),
+                                     kOccluder, true);
       }
       for (Eigen::Index i = 0; i < in.problem->positions.cols(); ++i) {
         const auto a = project(cMw, k, in.problem->positions.col(i));
@@ -184,9 +193,12 @@ struct LiveDisplay::Impl {
     if (in.step) {
       for (const OccluderTrack& t : in.step->tracks) {
         if (!t.confirmed || t.points.cols() == 0) continue;
-        const auto a = project(cMw, k, t.position), b = project(cMw, k, t.position + 0.5 * t.velocity);
+        const auto a = project(cMw, k, t.position),
+                   b = project(cMw, k, t.position + 0.5 * t.velocity);
         if (a && b) vpDisplay::displayArrow(camera, *a, *b, kTrack, 6, 3, 2);
-        if (a) vpDisplay::displayText(camera, *a + vpImagePoint(14, 6), "#" + std::to_string(t.id), kTrack);
+        if (a)
+          vpDisplay::displayText(camera, *a + vpImagePoint(14, 6), "#" + std::to_string(t.id),
+                                 kTrack);
       }
     }
     // The sphere feature: s* puts C at the image centre (x = y = 0) on the
@@ -205,7 +217,8 @@ struct LiveDisplay::Impl {
       if (target && (*target - *centroid).norm() > 1e-9) {
         try {
           FeatureSphereView s;
-          s.build(to_visp(in.wMc).inverse(), vpColVector{centroid->x(), centroid->y(), centroid->z()},
+          s.build(to_visp(in.wMc).inverse(),
+                  vpColVector{centroid->x(), centroid->y(), centroid->z()},
                   vpColVector{target->x(), target->y(), target->z()}, options.r_sphere);
           feature_error = s.get_s();  // s* = 0
         } catch (const std::exception&) {
@@ -220,20 +233,25 @@ struct LiveDisplay::Impl {
     } else if (in.step) {
       head += std::string("  ") + to_string(in.step->status);
     }
-    if (in.step && in.step->safety != SafetyAction::None) head += std::string("  safety: ") + to_string(in.step->safety);
+    if (in.step && in.step->safety != SafetyAction::None)
+      head += std::string("  safety: ") + to_string(in.step->safety);
     vpDisplay::displayText(camera, 14, 6, head, kText);
     if (feature_error.size() == 6) {
-      const double f = std::sqrt(feature_error[3] * feature_error[3] + feature_error[4] * feature_error[4] +
-                                 feature_error[5] * feature_error[5]);
-      vpDisplay::displayText(camera, 30, 6, format("s: x %+.3f  y %+.3f  rho-R %+.3f  |f| %.3f", feature_error[0],
-                                                   feature_error[1], feature_error[2], f), kCurrent);
-      vpDisplay::displayText(camera, 46, 6, "s*: 0 (C centred, on the sphere, on the target ray)", kDesired);
+      const double f =
+          std::sqrt(feature_error[3] * feature_error[3] + feature_error[4] * feature_error[4] +
+                    feature_error[5] * feature_error[5]);
+      vpDisplay::displayText(camera, 30, 6,
+                             format("s: x %+.3f  y %+.3f  rho-R %+.3f  |f| %.3f", feature_error[0],
+                                    feature_error[1], feature_error[2], f),
+                             kCurrent);
+      vpDisplay::displayText(camera, 46, 6, "s*: 0 (C centred, on the sphere, on the target ray)",
+                             kDesired);
     }
     vpDisplay::displayText(camera, static_cast<int>(camera.getHeight()) - 8, 6,
                            state() == DisplayControl::State::Paused
                                ? "PAUSED - left click: resume, right click: end"
-                               : options.pause ? "left click: pause, right click or q: end"
-                                               : "right click or q: end (no pause here)",
+                           : options.pause ? "left click: pause, right click or q: end"
+                                           : "right click or q: end (no pause here)",
                            kText);
     vpDisplay::flush(camera);
 #else
@@ -243,7 +261,8 @@ struct LiveDisplay::Impl {
 #endif
   }
 
-  void draw_scene(const DisplayInput& in, const Eigen::Vector3d* centroid, const std::optional<Eigen::Vector3d>& target) {
+  void draw_scene(const DisplayInput& in, const Eigen::Vector3d* centroid,
+                  const std::optional<Eigen::Vector3d>& target) {
 #if defined(VISP_HAVE_DISPLAY)
     if (!scene_window) return;
     SceneState state;
@@ -262,7 +281,8 @@ struct LiveDisplay::Impl {
     const RgbPicture picture = scene_picture(state, path, options.r_sphere);
     const std::uint8_t* p = picture.rgb.data();
     vpRGBa* q = scene.bitmap;
-    for (std::size_t i = 0, n = scene.getSize(); i < n; ++i, p += 3) q[i] = vpRGBa(p[0], p[1], p[2]);
+    for (std::size_t i = 0, n = scene.getSize(); i < n; ++i, p += 3)
+      q[i] = vpRGBa(p[0], p[1], p[2]);
     vpDisplay::display(scene);
     vpDisplay::flush(scene);
 #else
@@ -275,7 +295,8 @@ struct LiveDisplay::Impl {
   void draw_plot(const DisplayInput& in, const vpColVector& velocity) {
 #if defined(VISP_HAVE_DISPLAY)
     if (!plot) return;
-    if (options.ground_truth && in.visible_fraction) plot->plot(0, 0, in.time, *in.visible_fraction);
+    if (options.ground_truth && in.visible_fraction)
+      plot->plot(0, 0, in.time, *in.visible_fraction);
     if (velocity.size() == 6) plot->plot(velocity_graph, in.time, velocity);
     if (feature_error.size() == 6) plot->plot(error_graph, in.time, feature_error);
 #else
@@ -290,14 +311,16 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
   m.options = options;
   m.control = DisplayControl(options.pause);
   if (!(options.r_sphere > 0.0) || !std::isfinite(options.r_sphere)) {
-    throw std::invalid_argument("display: r_sphere must be a positive length, not " + std::to_string(options.r_sphere));
+    throw std::invalid_argument("display: r_sphere must be a positive length, not " +
+                                std::to_string(options.r_sphere));
   }
 #if !defined(VISP_HAVE_DISPLAY)
   throw DisplayUnavailable("--display: this ViSP was built without a display (X11 or OpenCV)");
 #else
   const char* display = std::getenv("DISPLAY");
   if (display == nullptr || *display == '\0') {
-    throw DisplayUnavailable("--display: no display (DISPLAY is not set); run without --display, or under xvfb-run");
+    throw DisplayUnavailable(
+        "--display: no display (DISPLAY is not set); run without --display, or under xvfb-run");
   }
 #if defined(VISP_HAVE_X11)
   // The connection first, by itself: vpDisplayX leaks its colour table when
@@ -320,7 +343,8 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
     }
     if (options.plot) {
       const unsigned graphs = options.ground_truth ? 3 : 2;
-      m.plot = std::make_unique<vpPlot>(graphs, 180 * graphs + 60, 640, 0, 520, options.title + ": curves");
+      m.plot = std::make_unique<vpPlot>(graphs, 180 * graphs + 60, 640, 0, 520,
+                                        options.title + ": curves");
       unsigned g = 0;
       if (options.ground_truth) {
         m.plot->initGraph(g, 1);
@@ -340,8 +364,8 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
       m.plot->initRange(m.error_graph, 0.0, 1.0, -0.2, 0.2);
       const char* v_names[6] = {"vx", "vy", "vz", "wx", "wy", "wz"};
       const char* e_names[6] = {"x", "y", "rho-R", "fx", "fy", "fz"};
-      const vpColor colours[6] = {vpColor::red, vpColor::green, vpColor::blue, vpColor::orange, vpColor::purple,
-                                  vpColor::cyan};
+      const vpColor colours[6] = {vpColor::red,    vpColor::green,  vpColor::blue,
+                                  vpColor::orange, vpColor::purple, vpColor::cyan};
       for (unsigned i = 0; i < 6; ++i) {
         m.plot->setLegend(m.velocity_graph, i, v_names[i]);
         m.plot->setColor(m.velocity_graph, i, colours[i]);
@@ -350,8 +374,8 @@ LiveDisplay::LiveDisplay(const LiveDisplayOptions& options) : impl_(std::make_un
       }
     }
   } catch (const vpException& e) {
-    throw DisplayUnavailable(std::string("--display: cannot open a window on display ") + display + ": " +
-                             e.getStringMessage());
+    throw DisplayUnavailable(std::string("--display: cannot open a window on display ") + display +
+                             ": " + e.getStringMessage());
   }
 #endif
 }
@@ -379,7 +403,9 @@ bool LiveDisplay::show(const DisplayInput& in) {
 
   if (m.options.pace_rate > 0.0) {
     const auto period = std::chrono::duration<double>(1.0 / m.options.pace_rate);
-    if (m.last_shown) std::this_thread::sleep_until(*m.last_shown + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period));
+    if (m.last_shown)
+      std::this_thread::sleep_until(
+          *m.last_shown + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period));
   }
   m.poll();
   if (m.state() == DisplayControl::State::Paused) {
@@ -422,7 +448,9 @@ bool LiveDisplay::observe(const RobotLoopFrame& f) {
   return show(in);
 }
 
-void LiveDisplay::set_pause_hook(std::function<void()> hook) { impl_->pause_hook = std::move(hook); }
+void LiveDisplay::set_pause_hook(std::function<void()> hook) {
+  impl_->pause_hook = std::move(hook);
+}
 DisplayControl::State LiveDisplay::handle(DisplayControl::Event event) {
   impl_->handle(event);
   return impl_->state();
@@ -457,7 +485,9 @@ void LiveDisplay::grab_plot(vpImage<vpRGBa>& image) const {
   image = vpImage<vpRGBa>();
 }
 
-std::optional<Eigen::Vector2d> LiveDisplay::last_centroid_pixel() const { return impl_->centroid_pixel; }
+std::optional<Eigen::Vector2d> LiveDisplay::last_centroid_pixel() const {
+  return impl_->centroid_pixel;
+}
 vpColVector LiveDisplay::last_feature_error() const { return impl_->feature_error; }
 
 }  // namespace ofv

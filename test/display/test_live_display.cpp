@@ -37,13 +37,15 @@ TEST(DisplayControl, RightClickOrQuitKeyEndsFromEitherStateForGood) {
     EXPECT_EQ(running.handle(quit), State::Quit);
     paused.handle(Event::LeftClick);
     EXPECT_EQ(paused.handle(quit), State::Quit);
-    for (const Event e : {Event::LeftClick, Event::MiddleClick, Event::PauseKey}) EXPECT_EQ(paused.handle(e), State::Quit);
+    for (const Event e : {Event::LeftClick, Event::MiddleClick, Event::PauseKey})
+      EXPECT_EQ(paused.handle(e), State::Quit);
   }
 }
 
 TEST(DisplayControl, WithoutPauseOnlyQuitChangesTheState) {
   DisplayControl c(/*pausable=*/false);
-  for (const Event e : {Event::LeftClick, Event::MiddleClick, Event::PauseKey}) EXPECT_EQ(c.handle(e), State::Running);
+  for (const Event e : {Event::LeftClick, Event::MiddleClick, Event::PauseKey})
+    EXPECT_EQ(c.handle(e), State::Running);
   EXPECT_EQ(c.handle(Event::QuitKey), State::Quit);
 }
 
@@ -107,12 +109,12 @@ bool have_display() {
   const char* d = std::getenv("DISPLAY");
   return d != nullptr && *d != '\0';
 }
-#define REQUIRE_DISPLAY()                                                           \
-  do {                                                                              \
-    if (!have_display()) {                                                          \
+#define REQUIRE_DISPLAY()                                                            \
+  do {                                                                               \
+    if (!have_display()) {                                                           \
       if (std::getenv("OFV_REQUIRE_DISPLAY")) FAIL() << "no DISPLAY under xvfb-run"; \
-      GTEST_SKIP() << "no DISPLAY (the ctest display.* tests run under xvfb-run)";  \
-    }                                                                               \
+      GTEST_SKIP() << "no DISPLAY (the ctest display.* tests run under xvfb-run)";   \
+    }                                                                                \
   } while (0)
 
 // Pixels of exactly `colour` within `radius` of (u, v).
@@ -120,7 +122,9 @@ int count_near(const vpImage<vpRGBa>& I, double u, double v, int radius, const v
   int n = 0;
   for (int r = static_cast<int>(v) - radius; r <= static_cast<int>(v) + radius; ++r) {
     for (int c = static_cast<int>(u) - radius; c <= static_cast<int>(u) + radius; ++c) {
-      if (r < 0 || c < 0 || r >= static_cast<int>(I.getHeight()) || c >= static_cast<int>(I.getWidth())) continue;
+      if (r < 0 || c < 0 || r >= static_cast<int>(I.getHeight()) ||
+          c >= static_cast<int>(I.getWidth()))
+        continue;
       const vpRGBa& p = I[r][c];
       n += p.R == colour.R && p.G == colour.G && p.B == colour.B ? 1 : 0;
     }
@@ -129,7 +133,8 @@ int count_near(const vpImage<vpRGBa>& I, double u, double v, int radius, const v
 }
 
 int count(const vpImage<vpRGBa>& I, const vpRGBa& colour) {
-  return count_near(I, I.getWidth() / 2.0, I.getHeight() / 2.0, static_cast<int>(std::max(I.getWidth(), I.getHeight())), colour);
+  return count_near(I, I.getWidth() / 2.0, I.getHeight() / 2.0,
+                    static_cast<int>(std::max(I.getWidth(), I.getHeight())), colour);
 }
 
 EpisodeSetup short_episode(double duration) {
@@ -139,7 +144,8 @@ EpisodeSetup short_episode(double duration) {
 
 TEST(LiveDisplay, WindowsShowTheDrawingsAtTheProjectedCentroid) {
   REQUIRE_DISPLAY();
-  const EpisodeSetup setup = short_episode(1.2);  // the hand is in the sphere by then: tracks, occluders
+  const EpisodeSetup setup =
+      short_episode(1.2);  // the hand is in the sphere by then: tracks, occluders
   LiveDisplayOptions options;
   options.title = "ofv-test";
   options.r_sphere = setup.loop.estimator.resolve().r_sphere;
@@ -147,11 +153,12 @@ TEST(LiveDisplay, WindowsShowTheDrawingsAtTheProjectedCentroid) {
   LiveDisplay display(options);
   StepRecord last;
   int occluded_frames = 0;
-  const EpisodeOutcome outcome = run_episode(setup, [&](const StepRecord& rec, const StepDetail& d) {
-    ASSERT_TRUE(display.observe(rec, d));
-    last = rec;
-    occluded_frames += d.problem && d.problem->occluders.cols() > 0 ? 1 : 0;
-  });
+  const EpisodeOutcome outcome =
+      run_episode(setup, [&](const StepRecord& rec, const StepDetail& d) {
+        ASSERT_TRUE(display.observe(rec, d));
+        last = rec;
+        occluded_frames += d.problem && d.problem->occluders.cols() > 0 ? 1 : 0;
+      });
   ASSERT_GT(occluded_frames, 0);
 
   // Where the true centroid projects (independently of the display).
@@ -182,7 +189,8 @@ TEST(LiveDisplay, WindowsShowTheDrawingsAtTheProjectedCentroid) {
   EXPECT_GE(count(camera, vpRGBa(230, 60, 60)), 9);
   // The rendered frame is underneath: many colours, not a blank window.
   int differing = 0;
-  for (unsigned i = 1; i < camera.getSize(); ++i) differing += camera.bitmap[i] == camera.bitmap[0] ? 0 : 1;
+  for (unsigned i = 1; i < camera.getSize(); ++i)
+    differing += camera.bitmap[i] == camera.bitmap[0] ? 0 : 1;
   EXPECT_GT(differing, static_cast<int>(camera.getSize() / 2));
   // The scene view: drawn on its dark background, with the supervoxels.
   EXPECT_LT(count(scene, vpRGBa(30, 30, 30)), static_cast<int>(scene.getSize()) - 2000);
@@ -220,7 +228,8 @@ TEST(LiveDisplay, PauseCallsTheHookAndWaitsUntilResumed) {
     if (frames == 2) display.handle(Event::LeftClick);  // pause before the third frame
     const auto start = std::chrono::steady_clock::now();
     EXPECT_TRUE(display.observe(rec, d));
-    longest = std::max(longest, std::chrono::duration<double>(std::chrono::steady_clock::now() - start));
+    longest =
+        std::max(longest, std::chrono::duration<double>(std::chrono::steady_clock::now() - start));
     ++frames;
   });
   if (resumer.joinable()) resumer.join();

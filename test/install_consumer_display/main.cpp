@@ -8,7 +8,8 @@
 int main() {
   unsetenv("DISPLAY");
   ofv::DisplayControl control;
-  if (control.handle(ofv::DisplayControl::Event::RightClick) != ofv::DisplayControl::State::Quit) return 1;
+  if (control.handle(ofv::DisplayControl::Event::RightClick) != ofv::DisplayControl::State::Quit)
+    return 1;
   try {
     ofv::LiveDisplay display({});
     std::cerr << "consumer_display: opened a window without a display\n";

@@ -15,7 +15,8 @@ namespace ofv {
 namespace {
 
 // Pinhole projection of a world point for drawing; nullopt behind the camera.
-std::optional<cv::Point> project(const Eigen::Isometry3d& wMc, const CameraIntrinsics& k, const Eigen::Vector3d& p) {
+std::optional<cv::Point> project(const Eigen::Isometry3d& wMc, const CameraIntrinsics& k,
+                                 const Eigen::Vector3d& p) {
   const Eigen::Vector3d c = wMc.inverse() * p;
   if (c.z() <= 1e-3) return std::nullopt;
   return cv::Point(static_cast<int>(std::lround(k.fx * c.x() / c.z() + k.cx)),
@@ -25,7 +26,8 @@ std::optional<cv::Point> project(const Eigen::Isometry3d& wMc, const CameraIntri
 }  // namespace
 
 // Drawn in BGR order with OpenCV (the colours below are B, G, R), returned as RGB.
-RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>& path, double r_sphere) {
+RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>& path,
+                         double r_sphere) {
   const std::optional<ViewEstimate>* estimate_ptr = s.step ? &s.step->estimate : nullptr;
   const bool has_estimate = estimate_ptr && estimate_ptr->has_value();
   const Eigen::Vector3d c = has_estimate ? (*estimate_ptr)->centroid : s.centroid;
@@ -70,8 +72,8 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
       const auto a = p(t.position), b = p(t.position + 0.5 * t.velocity);
       if (a && b) cv::arrowedLine(img, *a, *b, {40, 150, 255}, 2, cv::LINE_AA, 0, 0.2);
       if (a) {
-        cv::putText(img, "#" + std::to_string(t.id), *a + cv::Point(6, 12), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                    {40, 150, 255}, 1, cv::LINE_AA);
+        cv::putText(img, "#" + std::to_string(t.id), *a + cv::Point(6, 12),
+                    cv::FONT_HERSHEY_SIMPLEX, 0.4, {40, 150, 255}, 1, cv::LINE_AA);
       }
     }
   }
@@ -82,7 +84,8 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
   auto mark = [&](const Eigen::Vector3d& w, const cv::Scalar& colour, const char* label) {
     if (const auto a = p(w)) {
       cv::circle(img, *a, 6, colour, 2, cv::LINE_AA);
-      cv::putText(img, label, *a + cv::Point(8, -6), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
+      cv::putText(img, label, *a + cv::Point(8, -6), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1,
+                  cv::LINE_AA);
     }
   };
   mark(c, {255, 255, 255}, "C");
@@ -91,7 +94,8 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
     const ViewEstimate& estimate = **estimate_ptr;
     mark(estimate.t0, {0, 220, 255}, "t0");
     mark(estimate.tf, {80, 220, 80}, "tf");
-    if (s.step->target && (*s.step->target - estimate.tf).norm() > 1e-3) mark(*s.step->target, {220, 80, 220}, "target");
+    if (s.step->target && (*s.step->target - estimate.tf).norm() > 1e-3)
+      mark(*s.step->target, {220, 80, 220}, "target");
   } else if (s.target) {
     mark(*s.target, {220, 80, 220}, "target");
   }
@@ -99,7 +103,8 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
   text << std::fixed << std::setprecision(2) << "t=" << s.time << " s   ";
   if (s.visible_fraction) text << "visible " << *s.visible_fraction << "   ";
   if (s.status) text << "status " << to_string(*s.status);
-  cv::putText(img, text.str(), {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {255, 255, 255}, 1, cv::LINE_AA);
+  cv::putText(img, text.str(), {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {255, 255, 255}, 1,
+              cv::LINE_AA);
 
   RgbPicture out;
   out.width = k.width;

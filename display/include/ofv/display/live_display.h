@@ -27,10 +27,10 @@
 #include "ofv/servo/robot_loop.h"
 #include "ofv/servo/view_loop.h"
 
-#include <Eigen/Geometry>
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpImage.h>
 #include <visp3/core/vpRGBa.h>
+#include <Eigen/Geometry>
 
 #include <functional>
 #include <memory>
@@ -101,9 +101,9 @@ struct DisplayInput {
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< the camera when the frame was taken
   /// The camera image; nullptr: a grey image of `intrinsics` (a loop without a sensor).
   const RgbdFrame* frame = nullptr;
-  CameraIntrinsics intrinsics;  ///< used when `frame` is nullptr
+  CameraIntrinsics intrinsics;           ///< used when `frame` is nullptr
   const ViewProblem* problem = nullptr;  ///< supervoxels and occluders (nullptr: object lost)
-  const LoopStep* step = nullptr;        ///< what ofv::ViewLoop did (nullptr: a loop of the caller's own)
+  const LoopStep* step = nullptr;  ///< what ofv::ViewLoop did (nullptr: a loop of the caller's own)
   /// The object's centroid when the step has no estimate (simulation: the true one).
   std::optional<Eigen::Vector3d> centroid;
   std::optional<Eigen::Vector3d> target;   ///< the view driven to, when there is no step
@@ -133,7 +133,8 @@ class LiveDisplay {
    *         the episode early).
    */
   bool show(const DisplayInput& input);
-  /// \brief show() for a step of ofv::run_episode (true visible fraction and centroid from the simulator).
+  /// \brief show() for a step of ofv::run_episode (true visible fraction and centroid from the
+  /// simulator).
   bool observe(const StepRecord& record, const StepDetail& detail);
   /// \brief show() for a frame of ofv::run_on_robot or ofv::rehearse (no ground truth).
   bool observe(const RobotLoopFrame& frame);
@@ -153,7 +154,8 @@ class LiveDisplay {
   void grab_plot(vpImage<vpRGBa>& image) const;
   /// \brief Where the last frame's centroid projected in the camera image [px], if in front.
   [[nodiscard]] std::optional<Eigen::Vector2d> last_centroid_pixel() const;
-  /// \brief The sphere feature's error s - s* of the last frame: (x, y, rho - R, f) (empty when undefined).
+  /// \brief The sphere feature's error s - s* of the last frame: (x, y, rho - R, f) (empty when
+  /// undefined).
   [[nodiscard]] vpColVector last_feature_error() const;
 
  private:

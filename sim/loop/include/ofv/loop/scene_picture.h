@@ -35,9 +35,9 @@ struct SceneState {
   /// true centroid; elsewhere the last one known).
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::optional<double> visible_fraction;  ///< the true visible fraction (simulation only)
-  std::optional<StepStatus> status;       ///< the loop's status (none: a loop of the caller's own)
-  const ViewProblem* problem = nullptr;  ///< supervoxels and occluders; nullptr when lost
-  const LoopStep* step = nullptr;        ///< estimate, target, tracks; nullptr when none
+  std::optional<StepStatus> status;        ///< the loop's status (none: a loop of the caller's own)
+  const ViewProblem* problem = nullptr;    ///< supervoxels and occluders; nullptr when lost
+  const LoopStep* step = nullptr;          ///< estimate, target, tracks; nullptr when none
   /// The target when there is no step (a caller's own servo loop).
   std::optional<Eigen::Vector3d> target;
 };
@@ -52,7 +52,7 @@ struct SceneState {
  *        fraction and status when known).
  * \param path the camera positions so far (world) [m].
  */
-[[nodiscard]] RgbPicture scene_picture(const SceneState& state, const std::vector<Eigen::Vector3d>& path,
-                                       double r_sphere);
+[[nodiscard]] RgbPicture scene_picture(const SceneState& state,
+                                       const std::vector<Eigen::Vector3d>& path, double r_sphere);
 
 }  // namespace ofv
