@@ -64,6 +64,11 @@ using WindowDisplay = vpDisplayX;
 using WindowDisplay = vpDisplayOpenCV;
 #endif
 
+// The scene view's camera path: the last positions kept (100 s at 30 Hz), and
+// the span of the curves before they start again [s].
+constexpr std::size_t kPathLength = 3000;
+constexpr double kPlotWindow = 120.0;
+
 // The drawing colours (R, G, B); the tests look for some of them.
 const vpColor kSupervoxel(60, 160, 255);
 const vpColor kOccluder(230, 60, 60);
@@ -112,7 +117,8 @@ struct LiveDisplay::Impl {
   std::unique_ptr<vpPlot> plot;
 #endif
   unsigned velocity_graph = 0, error_graph = 1;
-  std::vector<Eigen::Vector3d> path;
+  std::vector<Eigen::Vector3d> path;  ///< the camera's last kPathLength positions
+  std::optional<double> plot_start;   ///< time the curves start from [s]
   std::optional<Eigen::Vector3d> last_centroid;
   std::optional<Eigen::Vector2d> centroid_pixel;
   vpColVector feature_error;
@@ -295,6 +301,14 @@ struct LiveDisplay::Impl {
   void draw_plot(const DisplayInput& in, const vpColVector& velocity) {
 #if defined(VISP_HAVE_DISPLAY)
     if (!plot) return;
+    // A run of hours: the curves start again every kPlotWindow seconds
+    // (vpPlot keeps every point and redraws them all when it rescales).
+    if (!plot_start || in.time < *plot_start || in.time - *plot_start > kPlotWindow) {
+      if (plot_start) {
+        for (unsigned g = 0; g <= error_graph; ++g) plot->resetPointList(g);
+      }
+      plot_start = in.time;
+    }
     if (options.ground_truth && in.visible_fraction)
       plot->plot(0, 0, in.time, *in.visible_fraction);
     if (velocity.size() == 6) plot->plot(velocity_graph, in.time, velocity);
@@ -385,7 +399,8 @@ LiveDisplay::~LiveDisplay() = default;
 bool LiveDisplay::show(const DisplayInput& in) {
   Impl& m = *impl_;
   if (m.state() == DisplayControl::State::Quit) return false;
-  m.path.push_back(in.wMc.translation());
+  m.path.emplace_back(in.wMc.translation());
+  if (m.path.size() > 2 * kPathLength) m.path.erase(m.path.begin(), m.path.end() - kPathLength);
   const Eigen::Vector3d* centroid = nullptr;
   if (in.step && in.step->estimate) {
     m.last_centroid = in.step->estimate->centroid;

@@ -261,5 +261,28 @@ TEST(LiveDisplay, QuitEndsTheEpisodeFromTheObserver) {
   EXPECT_FALSE(display.show({}));  // stays ended
 }
 
+TEST(LiveDisplay, ALoopOfOnesOwnAndHoursOfCurves) {
+  REQUIRE_DISPLAY();
+  LiveDisplayOptions options;
+  options.scene = false;
+  LiveDisplay display(options);
+  // No sensor, no ViewLoop: a centroid 0.5 m ahead, a target on the sphere,
+  // a twist; the curves start again past their window (every 2 minutes).
+  for (int k = 0; k <= 40; ++k) {
+    DisplayInput in;
+    in.time = 10.0 * k;
+    in.centroid = Eigen::Vector3d(0, 0, 0.5);
+    in.target = Eigen::Vector3d(0.25, 0, 0.5 - 0.433);
+    in.velocity = vpColVector{0.01 * k, 0, 0, 0, 0, 0};
+    ASSERT_TRUE(display.show(in));
+  }
+  vpImage<vpRGBa> camera;
+  display.grab_camera(camera);
+  ASSERT_EQ(camera.getWidth(), 640u);  // the default intrinsics
+  EXPECT_GE(count_near(camera, 320, 240, 10, vpRGBa(0, 255, 0)), 12);  // C at the centre
+  ASSERT_EQ(display.last_feature_error().size(), 6u);
+  EXPECT_NEAR(display.last_feature_error()[2], 0.0, 1e-9);  // the camera at 0.5 m: on the sphere
+}
+
 }  // namespace
 }  // namespace ofv
