@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 #endif
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -60,7 +62,7 @@ Command add_simulate_command(CLI::App& app) {
                 "Run the arm on ViSP's threaded simulator (vpSimulatorViper850/Afma6) in wall-clock time: a "
                 "real-time demo, not exactly repeatable (needs --robot viper850 or afma6)");
 #if defined(OFV_HAVE_DISPLAY)
-  sub->add_flag("--display", opt->display,
+  CLI::Option* display_flag = sub->add_flag("--display", opt->display,
                 "Show the loop live in ViSP windows: the camera image with supervoxels, occluders, tracks and the "
                 "feature, the scene view, and curves (visible fraction, velocity, feature error). Left click: pause "
                 "and resume (not with --real-time); right click or q: end the episode (its files are written, marked ended_by_user). Needs "
@@ -69,7 +71,13 @@ Command add_simulate_command(CLI::App& app) {
                   "With --display: frames shown at this multiple of the scenario's rate (1 = real time, 0 = as fast "
                   "as the loop runs); the episode's results do not depend on it")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(CLI::Range(0.0, 1000.0))
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            return std::isfinite(std::strtod(text.c_str(), nullptr)) ? std::string() : "not a finite number";
+          },
+          "", "finite"))
+      ->needs(display_flag);
 #endif
   std::string list;
   for (const auto& n : sim::builtin_scenarios()) list += (list.empty() ? "" : ", ") + n;

@@ -1,6 +1,7 @@
 #!/bin/sh
 # `--display` end to end. Usage: cli_display.sh MODE OFV_BINARY WORK_DIR
-#   no-display    without DISPLAY, `ofv simulate --display` and `ofv run --display` exit 2 with one line
+#   no-display    without DISPLAY, `ofv simulate --display` and `ofv run --display` exit 2 with one
+#                 line; a bad --display-speed exits 2
 #   same-metrics  (under Xvfb) the episode's metrics and trajectory are those without --display
 #   quit          (under Xvfb, xdotool) a left click pauses, another resumes, a right click ends the
 #                 episode early: exit 0, files written, metrics.json marked ended_by_user
@@ -21,6 +22,13 @@ no-display)
     [ $rc -eq 2 ] || fail "ofv $cmd: exit $rc, not 2"
     [ "$(wc -l < "$work/nd.err")" -eq 1 ] || fail "ofv $cmd: not one line on stderr"
     grep -q -- "--display: no display (DISPLAY is not set)" "$work/nd.err" || fail "ofv $cmd: message"
+  done
+  # --display-speed: finite, in [0, 1000], only with --display.
+  for speed in "--display --display-speed nan" "--display --display-speed -1" "--display-speed 2"; do
+    # shellcheck disable=SC2086
+    env -u DISPLAY "$ofv" simulate dvd-one-hand $speed --out "$work/nd" >/dev/null 2>&1
+    rc=$?
+    [ $rc -eq 2 ] || fail "ofv simulate $speed: exit $rc, not 2"
   done
   ;;
 same-metrics)
