@@ -202,29 +202,11 @@ Command add_run_command(CLI::App& app) {
               std::vector<std::pair<std::string, std::string>> settings;
               for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
               if (!real) settings.insert(settings.begin(), {"robot", opt->robot});
-              if (simulated) {
-                setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
-                setup.real_time = true;
-                if (setup.robot == RobotKind::Camera) {
-                  throw std::invalid_argument("--source sim: needs --robot viper850 or afma6 (ViSP's threaded simulators)");
-                }
-              } else {
-                setup.duration = std::numeric_limits<double>::infinity();
-                episode_settings_table().apply(setup, settings);
-                (void)ViewLoop(setup.loop);  // validates
-                if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time) {
-                  throw std::invalid_argument("settings perception, seed and real_time need --source sim:SCENARIO");
-                }
-                const vpHomogeneousMatrix eMc = opt->emc.empty() ? vpHomogeneousMatrix() : read_eMc(opt->emc);
-                robot = real ? real_robot(opt->robot, eMc) : make_robot(setup.robot, vpHomogeneousMatrix());
-                if (!robot) {
-                  throw std::invalid_argument("--robot " + opt->robot + ": unknown (simulated: camera, viper850, afma6; real drivers: " +
-                                              real_drivers() + ")");
-                }
-                source = open_source(opt->source, 1.0f);
-              }
+              // The windows open once the settings are valid, before a driver
+              // starts or a source opens: no display is an error at start.
+              const auto open_display = [&] {
 #if defined(OFV_HAVE_DISPLAY)
-              if (opt->display) {
+                if (!opt->display) return;
                 LiveDisplayOptions options;
                 options.title = "ofv run";
                 options.r_sphere = setup.loop.estimator.resolve().r_sphere;
@@ -233,11 +215,36 @@ Command add_run_command(CLI::App& app) {
                 // would keep its command, so a rehearsal has no pause.
                 options.pause = !simulated;
                 display = std::make_unique<LiveDisplay>(options);
-                if (robot && (!opt->dry_run || !real)) {
-                  display->set_pause_hook([&robot] { (void)robot->step(vpColVector(6, 0.0), 0.0); });
+                if (!opt->dry_run || !real) {
+                  display->set_pause_hook([&robot] {
+                    if (robot) (void)robot->step(vpColVector(6, 0.0), 0.0);
+                  });
                 }
-              }
 #endif
+              };
+              if (simulated) {
+                setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
+                setup.real_time = true;
+                if (setup.robot == RobotKind::Camera) {
+                  throw std::invalid_argument("--source sim: needs --robot viper850 or afma6 (ViSP's threaded simulators)");
+                }
+                open_display();
+              } else {
+                setup.duration = std::numeric_limits<double>::infinity();
+                episode_settings_table().apply(setup, settings);
+                (void)ViewLoop(setup.loop);  // validates
+                if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time) {
+                  throw std::invalid_argument("settings perception, seed and real_time need --source sim:SCENARIO");
+                }
+                open_display();
+                const vpHomogeneousMatrix eMc = opt->emc.empty() ? vpHomogeneousMatrix() : read_eMc(opt->emc);
+                robot = real ? real_robot(opt->robot, eMc) : make_robot(setup.robot, vpHomogeneousMatrix());
+                if (!robot) {
+                  throw std::invalid_argument("--robot " + opt->robot + ": unknown (simulated: camera, viper850, afma6; real drivers: " +
+                                              real_drivers() + ")");
+                }
+                source = open_source(opt->source, 1.0f);
+              }
             } catch (const std::exception& e) {  // sources report unreadable paths as runtime errors: here they are bad input
               std::cerr << "ofv run: " << e.what() << '\n';
               return kUsage;
