@@ -5,7 +5,7 @@
 #   same-metrics  (under Xvfb) the episode's metrics and trajectory are those without --display
 #   quit          (under Xvfb, xdotool) a left click pauses, another resumes, a right click ends the
 #                 episode early: exit 0, files written, metrics.json marked ended_by_user
-#   run-quit      (under Xvfb, xdotool) a right click stops `ofv run` as SIGTERM does
+#   run-quit      (under Xvfb, xdotool) a left click pauses `ofv run`, q stops it as SIGTERM does
 set -u
 mode=$1 ofv=$2 work=$3
 mkdir -p "$work"
@@ -92,7 +92,7 @@ quit)
 run-quit)
   # `ofv run --display` on a recording: a left click pauses the run (the
   # robot is sent a zero velocity) and no command follows while it is
-  # paused; a right click then stops it through the stop path of SIGTERM:
+  # paused; the key q then stops it through the stop path of SIGTERM:
   # the last command line is the stop, exit 0.
   xdotool=${OFV_XDOTOOL:-$(command -v xdotool)}
   case "$xdotool" in ""|*NOTFOUND) echo "xdotool not found: skipped"; exit 77 ;; esac
@@ -110,7 +110,7 @@ run-quit)
   sleep 2
   kill -0 $pid 2>/dev/null || fail "the run ended while paused"
   [ "$(wc -l < "$work/run.jsonl")" -eq "$paused_at" ] || fail "commands went on while paused"
-  "$xdotool" mousemove --window "$win" 40 40 click 3   # stop
+  "$xdotool" mousemove --window "$win" 40 40 key q     # stop (q: the pointer's window has the focus)
   wait $pid
   rc=$?
   cat "$work/run.err"
