@@ -14,6 +14,7 @@ packages=(
   nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox
+  xvfb xdotool  # the live display's tests (ctest -L display): windows under xvfb-run, clicks
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ -fsanitize=fuzzer (libFuzzer)
 )
 # --cluster: also what the sweep tests of ctest label `cluster` need (a

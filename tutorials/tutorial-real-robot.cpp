@@ -10,12 +10,21 @@
 //! only where ViSP has the driver (Debian's libvisp-dev has none: it then says
 //! so and exits, or with --dry-run prints the commands on a simulated camera).
 //!
-//!   tutorial-real-robot [--dry-run]
+//!   tutorial-real-robot [--dry-run] [--display]
+//!
+//! --display shows the loop live (ofv::LiveDisplay): the problem's
+//! supervoxels and occluders as the camera sees them, the feature, the scene
+//! view and the curves. A left click pauses (the robot is sent a zero
+//! velocity first), a right click or q stops as Ctrl-C does.
 //!
 //! With a sensor, `ofv::run_on_robot(source, robot, settings, options)` runs
 //! this same loop (perception included) until Ctrl-C; `ofv run` is that call.
 #include <ofv/servo/robot.h>
 #include <ofv/servo/view_loop.h>
+#if defined(OFV_HAVE_DISPLAY)
+#include <ofv/display/live_display.h>
+#include <ofv/servo/target_pose.h>
+#endif
 
 #include <visp3/core/vpConfig.h>
 #if defined(VISP_HAVE_VIPER850)
@@ -25,6 +34,7 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <memory>
 
 namespace {
 volatile std::sig_atomic_t stop_requested = 0;
@@ -47,7 +57,11 @@ ofv::ViewProblem frame_problem(double t) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool dry_run = argc > 1 && std::strcmp(argv[1], "--dry-run") == 0;
+  bool dry_run = false, display = false;
+  for (int i = 1; i < argc; ++i) {
+    dry_run = dry_run || std::strcmp(argv[i], "--dry-run") == 0;
+    display = display || std::strcmp(argv[i], "--display") == 0;
+  }
   std::signal(SIGINT, on_sigint);  // Ctrl-C: zero velocity, then exit
 
   // 1. Settings by name, as `ofv run --set` takes them; here a workspace box for the camera.
@@ -71,9 +85,33 @@ int main(int argc, char** argv) {
 
   // 3. The loop: one frame period at a time.
   const double dt = 1.0 / 30.0;
+#if defined(OFV_HAVE_DISPLAY)
+  // Optional live windows; a pause holds the robot, a quit stops as Ctrl-C.
+  std::unique_ptr<ofv::LiveDisplay> live;
+  if (display) {
+    try {
+      ofv::LiveDisplayOptions options;
+      options.title = "tutorial-real-robot";
+      options.r_sphere = loop.estimator().r_sphere;
+      options.pace_rate = 1.0 / dt;
+      live = std::make_unique<ofv::LiveDisplay>(options);
+      live->set_pause_hook([&robot] { robot.step(vpColVector(6, 0.0), 0.0); });
+    } catch (const ofv::DisplayUnavailable& e) {
+      std::cerr << "tutorial-real-robot: " << e.what() << '\n';
+      return 2;
+    }
+  }
+#else
+  if (display) {
+    std::cerr << "tutorial-real-robot: --display: this ofv was built without ofv::display\n";
+    return 2;
+  }
+#endif
   int clear = 0;
   for (int k = 0; k < 60 && !stop_requested; ++k) {
-    const ofv::LoopStep s = loop.step(frame_problem(k * dt), robot.wMc(), dt, /*frame_age=*/0.0);
+    const ofv::ViewProblem problem = frame_problem(k * dt);
+    const vpHomogeneousMatrix wMc = robot.wMc();
+    const ofv::LoopStep s = loop.step(problem, wMc, dt, /*frame_age=*/0.0);
     if (dry_run) {
       std::cout << "step " << k << ": " << ofv::to_string(s.status) << ", v = " << s.velocity.t();
       if (s.safety != ofv::SafetyAction::None) std::cout << "  (" << ofv::to_string(s.safety) << ')';
@@ -81,6 +119,16 @@ int main(int argc, char** argv) {
     }
     clear += s.status == ofv::StepStatus::Converged || s.status == ofv::StepStatus::NoOccluders ? 1 : 0;
     robot.step(s.velocity, dt);
+#if defined(OFV_HAVE_DISPLAY)
+    if (live) {
+      ofv::DisplayInput in;
+      in.time = k * dt;
+      in.wMc = ofv::to_eigen(wMc);
+      in.problem = &problem;
+      in.step = &s;
+      if (!live->show(in)) stop_requested = 1;  // the same stop as Ctrl-C
+    }
+#endif
   }
   robot.step(vpColVector(6, 0.0), 0.0);  // leave the robot at rest
   return clear > 0 ? 0 : 1;

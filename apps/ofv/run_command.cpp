@@ -6,6 +6,9 @@
 #include "ofv/servo/robot_loop.h"
 #include "ofv/servo/target_pose.h"
 #include "ofv/sources/open_source.h"
+#if defined(OFV_HAVE_DISPLAY)
+#include "ofv/display/live_display.h"
+#endif
 
 #include <visp3/core/vpConfig.h>
 #include <visp3/core/vpPoseVector.h>
@@ -151,6 +154,7 @@ Command add_run_command(CLI::App& app) {
     std::string emc;
     std::vector<std::string> sets;
     bool dry_run = false;
+    bool display = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("run", "Run the closed loop on a robot and a sensor, a recording, or a live simulation");
@@ -167,6 +171,13 @@ Command add_run_command(CLI::App& app) {
       ->type_name("NAME=VALUE");
   sub->add_flag("--dry-run", opt->dry_run,
                 "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
+#if defined(OFV_HAVE_DISPLAY)
+  sub->add_flag("--display", opt->display,
+                "Show the loop live in ViSP windows (camera image with supervoxels, occluders, tracks and the feature; "
+                "scene view; velocity and feature error curves). Left click: pause (the robot is sent a zero velocity "
+                "first; not in a sim: rehearsal, whose threaded arm would run on) and resume; right click or q: stop, "
+                "as SIGTERM does. Needs an X display (exit 2 without one)");
+#endif
   sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits (0). The object is picked in the first frame "
               "(the cluster nearest the image centre); when it is lost, or a frame is stale (older than stale_timeout "
               "after the previous one, or not after it), the robot stops. An error mid-run (the source, perception or "
@@ -184,16 +195,40 @@ Command add_run_command(CLI::App& app) {
             EpisodeSetup setup;
             std::unique_ptr<FrameSource> source;
             std::unique_ptr<CameraRobot> robot;
+#if defined(OFV_HAVE_DISPLAY)
+            std::unique_ptr<LiveDisplay> display;
+#endif
             try {
               std::vector<std::pair<std::string, std::string>> settings;
               for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
               if (!real) settings.insert(settings.begin(), {"robot", opt->robot});
+              // The windows open once the settings are valid, before a driver
+              // starts or a source opens: no display is an error at start.
+              const auto open_display = [&] {
+#if defined(OFV_HAVE_DISPLAY)
+                if (!opt->display) return;
+                LiveDisplayOptions options;
+                options.title = "ofv run";
+                options.r_sphere = setup.loop.estimator.resolve().r_sphere;
+                // A pause holds the robot: zero velocity, as at the end of a run.
+                // The rehearsal's arm is inside ofv::rehearse, out of reach: it
+                // would keep its command, so a rehearsal has no pause.
+                options.pause = !simulated;
+                display = std::make_unique<LiveDisplay>(options);
+                if (!opt->dry_run || !real) {
+                  display->set_pause_hook([&robot] {
+                    if (robot) (void)robot->step(vpColVector(6, 0.0), 0.0);
+                  });
+                }
+#endif
+              };
               if (simulated) {
                 setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
                 setup.real_time = true;
                 if (setup.robot == RobotKind::Camera) {
                   throw std::invalid_argument("--source sim: needs --robot viper850 or afma6 (ViSP's threaded simulators)");
                 }
+                open_display();
               } else {
                 setup.duration = std::numeric_limits<double>::infinity();
                 episode_settings_table().apply(setup, settings);
@@ -201,6 +236,7 @@ Command add_run_command(CLI::App& app) {
                 if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time) {
                   throw std::invalid_argument("settings perception, seed and real_time need --source sim:SCENARIO");
                 }
+                open_display();
                 const vpHomogeneousMatrix eMc = opt->emc.empty() ? vpHomogeneousMatrix() : read_eMc(opt->emc);
                 robot = real ? real_robot(opt->robot, eMc) : make_robot(setup.robot, vpHomogeneousMatrix());
                 if (!robot) {
@@ -215,15 +251,23 @@ Command add_run_command(CLI::App& app) {
             }
             try {
               CommandLines lines(opt->dry_run);
+              bool user_quit = false;  // the display's quit, not a signal
               const auto print = [&](const RobotLoopFrame& f) {
                 lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
                             to_string(f.step->safety), f.step->tracks);
+#if defined(OFV_HAVE_DISPLAY)
+                // The user ending the run stops it as SIGTERM does.
+                if (display && !display->observe(f)) {
+                  user_quit = true;
+                  g_stop = 1;
+                }
+#endif
               };
               if (simulated) {
                 const EpisodeOutcome outcome = rehearse(setup, &g_stop, print);
                 lines.close();
                 std::cout << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
-                          << (g_stop ? ", stopped" : "") << '\n'
+                          << (g_stop ? (user_quit ? ", stopped from the display" : ", stopped") : "") << '\n'
                           << episode_summary(outcome.metrics);
                 return kOk;
               }
@@ -235,7 +279,7 @@ Command add_run_command(CLI::App& app) {
               const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
               lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
-                        << (summary.stopped ? ", stopped by a signal" : "") << '\n';
+                        << (summary.stopped ? (user_quit ? ", stopped from the display" : ", stopped by a signal") : "") << '\n';
               return kOk;
             } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims (after the stop line)
               std::cerr << "ofv run: " << e.what() << '\n';

@@ -5,10 +5,19 @@
 #include "ofv/loop/episode.h"
 #include "ofv/loop/episode_files.h"
 #include "ofv/loop/progress.h"
+#if defined(OFV_HAVE_DISPLAY)
+#include "ofv/display/live_display.h"
 
+#include <nlohmann/json.hpp>
+#endif
+
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 
 namespace ofv::cli {
@@ -32,6 +41,8 @@ Command add_simulate_command(CLI::App& app) {
     bool pictures = true;
     bool real_time = false;
     bool video = false;
+    bool display = false;
+    double display_speed = 1.0;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("simulate", "Run the closed loop in simulation: render, perceive, estimate, servo");
@@ -50,6 +61,24 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_flag("--real-time", opt->real_time,
                 "Run the arm on ViSP's threaded simulator (vpSimulatorViper850/Afma6) in wall-clock time: a "
                 "real-time demo, not exactly repeatable (needs --robot viper850 or afma6)");
+#if defined(OFV_HAVE_DISPLAY)
+  CLI::Option* display_flag = sub->add_flag("--display", opt->display,
+                "Show the loop live in ViSP windows: the camera image with supervoxels, occluders, tracks and the "
+                "feature, the scene view, and curves (visible fraction, velocity, feature error). Left click: pause "
+                "and resume (not with --real-time); right click or q: end the episode (its files are written, marked ended_by_user). Needs "
+                "an X display (exit 2 without one)");
+  sub->add_option("--display-speed", opt->display_speed,
+                  "With --display: frames shown at this multiple of the scenario's rate (1 = real time, 0 = as fast "
+                  "as the loop runs); the episode's results do not depend on it")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0))
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            return std::isfinite(std::strtod(text.c_str(), nullptr)) ? std::string() : "not a finite number";
+          },
+          "", "finite"))
+      ->needs(display_flag);
+#endif
   std::string list;
   for (const auto& n : sim::builtin_scenarios()) list += (list.empty() ? "" : ", ") + n;
   sub->footer("Built-in scenarios: " + list + "\nWrites trajectory.csv, metrics.json and pictures (camera views and "
@@ -58,6 +87,9 @@ Command add_simulate_command(CLI::App& app) {
 
   return {sub, [opt]() -> int {
             EpisodeSetup setup;
+#if defined(OFV_HAVE_DISPLAY)
+            std::unique_ptr<LiveDisplay> display;
+#endif
             try {
               const sim::Scenario scenario = sim::load_scenario(opt->scenario);
               std::vector<std::pair<std::string, std::string>> settings;
@@ -67,6 +99,22 @@ Command add_simulate_command(CLI::App& app) {
               settings.emplace_back("seed", std::to_string(opt->seed));
               for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
               setup = resolve_episode(scenario, settings);
+#if defined(OFV_HAVE_DISPLAY)
+              if (opt->display) {
+                LiveDisplayOptions options;
+                options.title = "ofv simulate " + setup.scenario.name;
+                options.r_sphere = setup.loop.estimator.resolve().r_sphere;
+                options.ground_truth = true;
+                // The threaded arms already run in wall-clock time, and run on
+                // while the observer waits: no pause with --real-time.
+                options.pace_rate = setup.real_time ? 0.0 : opt->display_speed * setup.scenario.rate;
+                options.pause = !setup.real_time;
+                display = std::make_unique<LiveDisplay>(options);
+              }
+            } catch (const DisplayUnavailable& e) {
+              std::cerr << "ofv simulate: " << e.what() << '\n';
+              return kUsage;
+#endif
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv simulate: " << e.what() << '\n';
               return kUsage;
@@ -79,11 +127,40 @@ Command add_simulate_command(CLI::App& app) {
               files.record_dir = opt->record;
               EpisodeWriter writer(dir.string(), setup, files);
               ProgressBar progress(setup.duration, "s of the episode");
-              const EpisodeOutcome outcome = run_episode(setup, [&](const StepRecord& rec, const StepDetail& d) {
-                writer.observe(rec, d);
-                progress.set(rec.time);
-              });
+              // The user ending the episode from the display: thrown by the
+              // observer out of run_episode, with the steps seen so far.
+              struct EndedByUser {};
+              std::vector<StepRecord> seen;
+              EpisodeOutcome outcome;
+              bool ended_by_user = false;
+              try {
+                outcome = run_episode(setup, [&](const StepRecord& rec, const StepDetail& d) {
+                  writer.observe(rec, d);
+                  progress.set(rec.time);
+#if defined(OFV_HAVE_DISPLAY)
+                  if (display) {
+                    seen.push_back(rec);
+                    if (!display->observe(rec, d)) throw EndedByUser{};
+                  }
+#endif
+                });
+              } catch (const EndedByUser&) {
+                ended_by_user = true;
+                outcome.steps = std::move(seen);
+                outcome.metrics = summarise(outcome.steps);
+              }
               const std::vector<std::string> written = writer.finish(outcome);
+              (void)ended_by_user;
+#if defined(OFV_HAVE_DISPLAY)
+              if (ended_by_user) {  // metrics.json says so, with the duration asked for
+                const fs::path metrics = dir / "metrics.json";
+                nlohmann::json j = nlohmann::json::parse(std::ifstream(metrics));
+                j["ended_by_user"] = true;
+                j["planned_duration"] = setup.duration;
+                std::ofstream(metrics) << j.dump(2) << '\n';
+                std::cout << "ofv simulate: ended by the user at t=" << outcome.metrics.duration << " s\n";
+              }
+#endif
               std::cout << "ofv simulate: " << setup.scenario.name << ", robot " << to_string(setup.robot) << ", "
                         << to_string(setup.loop.method) << ", perception " << to_string(setup.perception) << '\n'
                         << episode_summary(outcome.metrics) << "  wrote " << written.size() << " files in " << dir.string()

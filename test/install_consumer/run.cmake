@@ -6,7 +6,8 @@ cmake_minimum_required(VERSION 3.16)
 #  - OFV_DATA_DIR points it at another data folder;
 #  - test/install_consumer* configure with find_package(ofv COMPONENTS ...),
 #    build and run: core (the estimator), servo (the sphere feature in the
-#    user's vpServo loop), loop (a short simulated episode);
+#    user's vpServo loop), loop (a short simulated episode), display (the
+#    live display refuses without a display);
 #  - asking for a component ofv does not have fails, naming it.
 # Arguments: OFV_BINARY_DIR, TEST_SOURCE_DIR (test/), WORK_DIR, COMPONENTS
 # (the components built), SCENARIOS (the built-in scenario names), both
@@ -41,7 +42,8 @@ file(RENAME ${WORK_DIR}/installed ${prefix})
 # Every public header of an installed component is installed.
 set(src ${TEST_SOURCE_DIR}/..)
 file(GLOB_RECURSE headers RELATIVE ${src} ${src}/include/ofv/*.h ${src}/servo/include/ofv/*.h
-                                          ${src}/sim/include/ofv/*.h ${src}/sim/loop/include/ofv/*.h)
+                                          ${src}/sim/include/ofv/*.h ${src}/sim/loop/include/ofv/*.h
+                                          ${src}/display/include/ofv/*.h)
 foreach(h IN LISTS headers)
   string(REGEX REPLACE "^.*include/(ofv/.*)$" "\\1" installed ${h})
   string(REGEX MATCH "^ofv/([a-z]+)/" dir ${installed})
@@ -84,6 +86,9 @@ if(servo IN_LIST COMPONENTS)
 endif()
 if(loop IN_LIST COMPONENTS)
   consumer(install_consumer_loop)
+endif()
+if(display IN_LIST COMPONENTS)
+  consumer(install_consumer_display)
 endif()
 
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${TEST_SOURCE_DIR}/install_consumer_missing

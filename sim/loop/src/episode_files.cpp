@@ -2,9 +2,9 @@
 #include "ofv/loop/episode_files.h"
 
 #include "gnuplot.h"
-#include "ofv/constants.h"
 
 #include "ofv/loop/metrics_json.h"
+#include "ofv/loop/scene_picture.h"
 #include "ofv/sources/tum_sequence.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -49,76 +49,21 @@ cv::Mat camera_picture(const StepRecord& rec, const StepDetail& d) {
   return img;
 }
 
-// A Fig. 6-style view of the scene from a virtual observer beside the camera:
-// object supervoxels and normals (blue), occluders (red), the sphere, C, the
-// real camera and its path (white), t0 (yellow), tf (green) and, where
-// target hysteresis kept another, the target the controller follows (magenta);
-// each confirmed occluder track as an orange arrow from its position to
-// where it will be in 0.5 s, with its id.
-cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d,
-                      const std::vector<Eigen::Vector3d>& path, double r_sphere) {
-  const std::optional<ViewEstimate>& estimate = d.step->estimate;
-  const Eigen::Vector3d c = estimate ? estimate->centroid : rec.true_centroid;
-  const Eigen::Vector3d eye = c + Eigen::Vector3d(0.9, -0.7, -0.6);
-  const Eigen::Vector3d z = (c - eye).normalized();
-  const Eigen::Vector3d x = Eigen::Vector3d(0, 1, 0).cross(z).normalized();
-  Eigen::Isometry3d wMo = Eigen::Isometry3d::Identity();
-  wMo.linear() << x, z.cross(x), z;
-  wMo.translation() = eye;
-  const CameraIntrinsics k{640, 480, 520.0, 520.0, 320.0, 240.0};
-  cv::Mat img(k.height, k.width, CV_8UC3, cv::Scalar(30, 30, 30));
-  auto p = [&](const Eigen::Vector3d& w) { return project(wMo, k, w); };
-  // The sphere's outline: great circles in three planes.
-  for (int axis = 0; axis < 3; ++axis) {
-    std::optional<cv::Point> prev;
-    for (int s = 0; s <= 72; ++s) {
-      const double a = 2.0 * kPi * s / 72;
-      Eigen::Vector3d q = Eigen::Vector3d::Zero();
-      q((axis + 1) % 3) = std::cos(a);
-      q((axis + 2) % 3) = std::sin(a);
-      const auto pt = p(c + r_sphere * q);
-      if (pt && prev) cv::line(img, *prev, *pt, {90, 90, 90}, 1, cv::LINE_AA);
-      prev = pt;
-    }
-  }
-  if (d.problem) {
-    for (Eigen::Index i = 0; i < d.problem->positions.cols(); ++i) {
-      const auto a = p(d.problem->positions.col(i));
-      const auto b = p(d.problem->positions.col(i) + 0.03 * d.problem->normals.col(i).normalized());
-      if (a) cv::circle(img, *a, 2, {255, 160, 60}, cv::FILLED);
-      if (a && b) cv::line(img, *a, *b, {200, 120, 60}, 1, cv::LINE_AA);
-    }
-    for (Eigen::Index i = 0; i < d.problem->occluders.cols(); ++i) {
-      if (const auto a = p(d.problem->occluders.col(i))) cv::rectangle(img, *a - cv::Point(2, 2), *a + cv::Point(2, 2), {60, 60, 230}, cv::FILLED);
-    }
-  }
-  for (const OccluderTrack& t : d.step->tracks) {
-    if (!t.confirmed || t.points.cols() == 0) continue;
-    const auto a = p(t.position), b = p(t.position + 0.5 * t.velocity);
-    if (a && b) cv::arrowedLine(img, *a, *b, {40, 150, 255}, 2, cv::LINE_AA, 0, 0.2);
-    if (a) cv::putText(img, "#" + std::to_string(t.id), *a + cv::Point(6, 12), cv::FONT_HERSHEY_SIMPLEX, 0.4, {40, 150, 255}, 1, cv::LINE_AA);
-  }
-  for (std::size_t i = 1; i < path.size(); ++i) {
-    const auto a = p(path[i - 1]), b = p(path[i]);
-    if (a && b) cv::line(img, *a, *b, {220, 220, 220}, 1, cv::LINE_AA);
-  }
-  auto mark = [&](const Eigen::Vector3d& w, const cv::Scalar& colour, const char* label) {
-    if (const auto a = p(w)) {
-      cv::circle(img, *a, 6, colour, 2, cv::LINE_AA);
-      cv::putText(img, label, *a + cv::Point(8, -6), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
-    }
-  };
-  mark(c, {255, 255, 255}, "C");
-  mark(rec.wMc.translation(), {255, 255, 255}, "t_real");
-  if (estimate) {
-    mark(estimate->t0, {0, 220, 255}, "t0");
-    mark(estimate->tf, {80, 220, 80}, "tf");
-    if (d.step->target && (*d.step->target - estimate->tf).norm() > 1e-3) mark(*d.step->target, {220, 80, 220}, "target");
-  }
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(2) << "t=" << rec.time << " s   visible " << rec.visible_fraction
-       << "   status " << to_string(rec.status);
-  cv::putText(img, text.str(), {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {255, 255, 255}, 1, cv::LINE_AA);
+// The scene view (ofv/loop/scene_picture.h) of a simulated step, BGR for OpenCV.
+cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d, const std::vector<Eigen::Vector3d>& path,
+                      double r_sphere) {
+  SceneState state;
+  state.time = rec.time;
+  state.wMc = rec.wMc;
+  state.centroid = rec.true_centroid;
+  state.visible_fraction = rec.visible_fraction;
+  state.status = rec.status;
+  state.problem = d.problem;
+  state.step = d.step;
+  const RgbPicture picture = ofv::scene_picture(state, path, r_sphere);
+  cv::Mat rgb(picture.height, picture.width, CV_8UC3, const_cast<std::uint8_t*>(picture.rgb.data()));
+  cv::Mat img;
+  cv::cvtColor(rgb, img, cv::COLOR_RGB2BGR);
   return img;
 }
 
