@@ -34,9 +34,9 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}")
 set(CPACK_PACKAGE_DESCRIPTION
     "ofv estimates occlusion-free views of an object from RGB-D frames and\n"
     "servoes a camera to them with ViSP. The package holds the ofv program,\n"
-    "the libraries (core, io, perception, sim, servo, loop) with their headers\n"
-    "and CMake package (find_package(ofv COMPONENTS ...)), and the built-in\n"
-    "scenarios and examples in /usr/share/ofv.")
+    "the libraries (core, io, perception, sim, servo, loop, display) with their\n"
+    "headers and CMake package (find_package(ofv COMPONENTS ...)), and the\n"
+    "built-in scenarios and examples in /usr/share/ofv.")
 list(JOIN CPACK_PACKAGE_DESCRIPTION "" CPACK_PACKAGE_DESCRIPTION)
 set(CPACK_PACKAGE_CONTACT "ofv maintainers <ofv@localhost>")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
