@@ -2,6 +2,7 @@
 #include "ofv/loop/episode_files.h"
 
 #include "gnuplot.h"
+#include "projection.h"
 
 #include "ofv/loop/metrics_json.h"
 #include "ofv/loop/scene_picture.h"
@@ -24,14 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Pinhole projection of a world point for drawing; nullopt behind the camera.
-std::optional<cv::Point> project(const Eigen::Isometry3d& wMc, const CameraIntrinsics& k,
-                                 const Eigen::Vector3d& p) {
-  const Eigen::Vector3d c = wMc.inverse() * p;
-  if (c.z() <= 1e-3) return std::nullopt;
-  return cv::Point(static_cast<int>(std::lround(k.fx * c.x() / c.z() + k.cx)),
-                   static_cast<int>(std::lround(k.fy * c.y() / c.z() + k.cy)));
-}
+using detail::project;
 
 // The camera's image with the true centroid (+) and the chosen target drawn on it.
 cv::Mat camera_picture(const StepRecord& rec, const StepDetail& d) {

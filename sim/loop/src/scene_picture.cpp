@@ -2,6 +2,7 @@
 #include "ofv/loop/scene_picture.h"
 
 #include "ofv/constants.h"
+#include "projection.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -12,18 +13,7 @@
 
 namespace ofv {
 
-namespace {
-
-// Pinhole projection of a world point for drawing; nullopt behind the camera.
-std::optional<cv::Point> project(const Eigen::Isometry3d& wMc, const CameraIntrinsics& k,
-                                 const Eigen::Vector3d& p) {
-  const Eigen::Vector3d c = wMc.inverse() * p;
-  if (c.z() <= 1e-3) return std::nullopt;
-  return cv::Point(static_cast<int>(std::lround(k.fx * c.x() / c.z() + k.cx)),
-                   static_cast<int>(std::lround(k.fy * c.y() / c.z() + k.cy)));
-}
-
-}  // namespace
+using detail::project;
 
 // Drawn in BGR order with OpenCV (the colours below are B, G, R), returned as RGB.
 RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>& path,
