@@ -175,3 +175,28 @@ def test_threads_run_episodes_in_parallel_with_the_results_of_one_at_a_time():
         for name, column in alone.trajectory.items():
             if name not in TIMING_COLUMNS:
                 np.testing.assert_array_equal(r.trajectory[name], column, err_msg=name)
+
+
+def test_ctrl_c_interrupts_a_long_episode():
+    """SIGINT during an episode (GIL released) raises KeyboardInterrupt within a fraction of a second."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    child = subprocess.Popen(
+        [sys.executable, "-c", "import ofv; print('go', flush=True); "
+         "ofv.simulate('dvd-one-hand', duration=600, perception='ground-truth')"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+    try:
+        assert child.stdout.readline().strip() == "go"
+        time.sleep(0.5)  # well into the episode
+        child.send_signal(signal.SIGINT)
+        start = time.monotonic()
+        _, err = child.communicate(timeout=30)
+        assert time.monotonic() - start < 5.0
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.communicate()
+    assert child.returncode != 0 and "KeyboardInterrupt" in err
