@@ -70,6 +70,19 @@ void apply_settings(EstimatorParams& p, const py::dict& settings) {
   for (const auto& [key, value] : settings) set_setting(p, py::str(key).cast<std::string>(), value);
 }
 
+// `settings=`: None (the defaults), an EstimatorSettings (copied) or a dict of settings by name.
+EstimatorParams params_arg(const py::handle& base) {
+  if (base.is_none()) return {};
+  if (py::isinstance<EstimatorParams>(base)) return base.cast<EstimatorParams>();
+  if (py::isinstance<py::dict>(base)) {
+    EstimatorParams p;
+    apply_settings(p, py::reinterpret_borrow<py::dict>(base));
+    return p;
+  }
+  throw py::type_error("settings: expected an ofv.EstimatorSettings or a dict, got a " +
+                       py::str(py::type::of(base).attr("__name__")).cast<std::string>());
+}
+
 py::dict settings_dict(const EstimatorParams& p) {
   const EstimatorSettings s = p.resolve();
   py::dict out;
@@ -285,7 +298,7 @@ void bind_estimator(py::module_& m) {
          const py::object& axes, const py::object& camera, const py::object& previous_view, const py::object& base,
          bool record_path, const py::kwargs& kw) {
         const ViewProblem problem = make_problem(positions, normals, occluders, centroid, axes, camera, previous_view);
-        EstimatorParams params = base.is_none() ? EstimatorParams{} : base.cast<EstimatorParams>();
+        EstimatorParams params = params_arg(base);
         apply_settings(params, kw);
         return run_estimate(problem, params, record_path, "");
       },
@@ -299,7 +312,7 @@ positions: (N, 3) supervoxel centroids v_n [m]; normals: (N, 3) their normals p_
 or None. Arrays must be float64 numpy arrays (any strides) or lists of numbers:
 other dtypes raise TypeError, other shapes ValueError. Optional, (3,) each:
 centroid C, camera (t0's last fallback), previous_view (used with warm_start);
-axes (3, 3), axes[k] = e_(k+1). settings: an EstimatorSettings to start from;
+axes (3, 3), axes[k] = e_(k+1). settings: an EstimatorSettings (or a dict) to start from;
 **settings: settings by name on top (e.g. r_sphere=0.4, preset='authors_code').
 record_path: also return every visited iterate (ViewEstimate.path).
 
@@ -318,7 +331,7 @@ released while the estimator runs.)");
                        const py::object& previous_view, const py::object& base, const py::kwargs& kw) {
              PyScene s;
              s.scene.problem = make_problem(positions, normals, occluders, centroid, axes, camera, previous_view);
-             if (!base.is_none()) s.scene.params = base.cast<EstimatorParams>();
+             s.scene.params = params_arg(base);
              apply_settings(s.scene.params, kw);
              return s;
            }),

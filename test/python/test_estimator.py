@@ -336,3 +336,14 @@ def test_the_gil_is_released_while_estimating():
     thread.join()
     assert e.status == ofv.ViewStatus.out_of_time and elapsed >= 0.4
     assert during > 1000  # the other thread ran while the estimator did
+
+
+def test_settings_argument_takes_settings_or_a_dict():
+    positions, normals, occluders = _scene_arrays()
+    expected = ofv.estimate_view(positions, normals, occluders, r_sphere=0.3, step=0.01).to_dict()
+    base = ofv.EstimatorSettings(r_sphere=0.3)
+    assert ofv.estimate_view(positions, normals, occluders, settings=base, step=0.01).to_dict() == expected
+    assert base.step == 0.02  # keyword settings apply to a copy
+    assert ofv.estimate_view(positions, normals, occluders, settings={"r_sphere": 0.3, "step": 0.01}).to_dict() == expected
+    with pytest.raises(TypeError, match="settings: expected an ofv.EstimatorSettings or a dict, got a int"):
+        ofv.estimate_view(positions, normals, occluders, settings=5)
