@@ -451,10 +451,7 @@ void bind_simulation(py::module_& m) {
                (e.out.empty() ? "" : ", files in " + e.out) + ")";
       });
 
-  m.def("simulate", &simulate, py::arg("scenario"), py::kw_only(), py::arg("out") = py::none(),
-        py::arg("pictures") = false, py::arg("video") = false, py::arg("record") = py::none(),
-        py::arg("callback") = py::none(),
-        R"(Runs one closed-loop episode, as `ofv simulate` (ofv::resolve_episode, ofv::run_episode).
+  static const std::string simulate_doc = std::string(R"(Runs one closed-loop episode, as `ofv simulate` (ofv::resolve_episode, ofv::run_episode).
 
 scenario: a Scenario, a built-in scenario's name or a scenario file. **settings: every
 setting of episode_settings() by name, applied after the scenario's own, in the order
@@ -469,7 +466,12 @@ the GIL is taken only for it. An exception it raises ends the episode and propag
 Returns an Episode: metrics (dict, the keys of metrics.json) and trajectory (dict of
 numpy columns, those of trajectory.csv). Raises ValueError on a bad setting (the
 message of `ofv simulate`), RuntimeError when the episode cannot run. The GIL is
-released while it runs: Python threads can run episodes in parallel.)");
+released while it runs: Python threads can run episodes in parallel.
+
+)") + settings_help(episode_settings_table().docs());
+  m.def("simulate", &simulate, py::arg("scenario"), py::kw_only(), py::arg("out") = py::none(),
+        py::arg("pictures") = false, py::arg("video") = false, py::arg("record") = py::none(),
+        py::arg("callback") = py::none(), simulate_doc.c_str());
 
   py::class_<Frame>(m, "Frame", "One rendered RGB-D frame (ViSP's camera frame: X right, Y down, Z forward).")
       .def_readonly("depth", &Frame::depth, "(H, W) float32 Z depth [m]; 0 or NaN where missing")

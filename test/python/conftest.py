@@ -57,3 +57,30 @@ def cli_json(run_cli):
 
 
 needs_simulation = pytest.mark.skipif(not ofv.HAS_SIMULATION, reason="ofv built without the closed loop")
+
+
+def samples_while_running(call):
+    """Runs call() while another Python thread records the time in a loop;
+    returns (call's result, how many of those records fall well inside the
+    call). Holding the GIL for the whole call would leave none there."""
+    import threading
+    import time
+
+    stamps = []
+    stop = threading.Event()
+
+    def record():
+        while not stop.is_set():
+            stamps.append(time.monotonic())
+            time.sleep(0.001)
+
+    thread = threading.Thread(target=record)
+    thread.start()
+    time.sleep(0.02)
+    start = time.monotonic()
+    result = call()
+    end = time.monotonic()
+    stop.set()
+    thread.join()
+    margin = 0.1 * (end - start)
+    return result, sum(start + margin < t < end - margin for t in stamps)

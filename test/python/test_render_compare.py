@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ofv
-from conftest import DATA, needs_simulation
+from conftest import DATA, needs_simulation, samples_while_running
 
 pytestmark = needs_simulation
 
@@ -165,3 +165,10 @@ def test_scene_data_files_of_the_repository_load():
     scenes = sorted((DATA.parent.parent / "data").rglob("*.json"))
     loaded = [ofv.load_scene(p) for p in scenes if "supervoxels" in p.read_text()[:2000]]
     assert all(len(s.positions) > 0 for s in loaded)
+
+
+def test_the_gil_is_released_while_rendering_and_comparing():
+    frame, inside = samples_while_running(lambda: ofv.render("dvd-one-hand", 1.0, size=(1280, 960)))
+    assert frame.depth.shape == (960, 1280) and inside > 5
+    tables, inside = samples_while_running(lambda: ofv.compare("dvd-static", GRID, jobs=1))
+    assert len(tables["episodes"]["variant"]) == 2 and inside > 20

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import ofv
-from conftest import TIMING_COLUMNS, TIMING_METRICS, needs_simulation
+from conftest import TIMING_COLUMNS, TIMING_METRICS, needs_simulation, samples_while_running
 
 pytestmark = needs_simulation
 
@@ -143,20 +143,11 @@ def test_scenarios_load_by_name_and_path():
 
 
 def test_threads_run_episodes_in_parallel_with_the_results_of_one_at_a_time():
-    """The GIL is released during an episode: another thread runs meanwhile,
+    """The GIL is released during an episode: other threads run meanwhile,
     and episodes in threads give what they give alone."""
-    alone = ofv.simulate("dvd-one-hand", duration=0.5, perception="ground-truth", seed=1)
-    count = [0]
-    stop = threading.Event()
-
-    def spin():
-        while not stop.is_set():
-            count[0] += 1
-
-    spinner = threading.Thread(target=spin)
-    spinner.start()
-    time.sleep(0.05)
-    before = count[0]
+    alone, inside = samples_while_running(
+        lambda: ofv.simulate("dvd-one-hand", duration=0.5, perception="ground-truth", seed=1))
+    assert inside > 20
     results = [None, None]
 
     def run(k):
@@ -167,10 +158,6 @@ def test_threads_run_episodes_in_parallel_with_the_results_of_one_at_a_time():
         w.start()
     for w in workers:
         w.join()
-    during = count[0] - before
-    stop.set()
-    spinner.join()
-    assert during > 1000
     for r in results:
         for name, column in alone.trajectory.items():
             if name not in TIMING_COLUMNS:
