@@ -134,6 +134,14 @@ std::string setting_text(const std::string& name, const py::handle& value) {
                        py::str(py::type::of(value).attr("__name__")).cast<std::string>());
 }
 
+py::object typed_value(const SettingDoc& doc, const std::string& text) {
+  const auto starts = [&](const char* prefix) { return doc.type.rfind(prefix, 0) == 0; };
+  if (doc.type == "bool") return py::bool_(text == "true");
+  if (starts("integer")) return py::int_(std::stoll(text));
+  if (starts("number") && numeric_field(text) && !text.empty()) return py::float_(std::strtod(text.c_str(), nullptr));
+  return py::str(text);
+}
+
 std::vector<std::pair<std::string, std::string>> settings_pairs(const py::dict& settings) {
   std::vector<std::pair<std::string, std::string>> out;
   for (const auto& [key, value] : settings) {

@@ -48,6 +48,18 @@ py::array_t<double> matrix_to_numpy(const Eigen::MatrixXd& m);
  */
 std::string setting_text(const std::string& name, const py::handle& value);
 
+/// \brief A setting's value text (a table row's getter) as the Python value of
+///        its type: float for `number...`, int for `integer...`, bool, else str.
+py::object typed_value(const SettingDoc& doc, const std::string& text);
+
+/// \brief Every setting of a table as {name: value}, typed by typed_value().
+template <class T>
+py::dict typed_values(const SettingsTable<T>& table, const T& source) {
+  py::dict out;
+  for (const auto& row : table.rows()) out[py::str(row.doc.name)] = typed_value(row.doc, row.get(source));
+  return out;
+}
+
 /// \brief `**settings` as `name=value` pairs in the order given.
 std::vector<std::pair<std::string, std::string>> settings_pairs(const py::dict& settings);
 

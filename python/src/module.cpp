@@ -6,12 +6,12 @@
 #include "ofv/estimator.h"
 #include "ofv/estimator_settings.h"
 #include "ofv/io/scene_json.h"
+#include "ofv/version.h"
 
 #include <nlohmann/json.hpp>
 #include <pybind11/stl.h>
 
 #include <fstream>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -20,41 +20,20 @@ namespace ofv::python {
 namespace {
 
 // --- EstimatorSettings: ofv::EstimatorParams (a preset plus explicit values),
-// every attribute a row of estimator_settings_table(). Reading gives the
-// resolved value (the preset's where none was given).
+// every attribute a row of estimator_settings_table(): read with the row's
+// getter (the resolved value, the preset's where none was given), written
+// with its setter.
 
-using Getter = py::object (*)(const EstimatorParams&, const EstimatorSettings&);
-
-// The value of each setting by name. The table has no getters (it parses
-// text); the module refuses to load if a row has no getter here or a getter
-// no row (check_getters), so a new setting cannot be missed.
-const std::map<std::string, Getter>& getters() {
-  static const std::map<std::string, Getter> g = {
-      {"preset", [](const EstimatorParams& p, const EstimatorSettings&) -> py::object { return py::str(to_string(p.preset)); }},
-      {"r_seed", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::float_(s.r_seed); }},
-      {"r_sphere", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::float_(s.r_sphere); }},
-      {"initial_view", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::str(to_string(s.initial_view)); }},
-      {"clearance", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::float_(s.clearance); }},
-      {"push_radius", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::float_(s.push_radius); }},
-      {"push_weighting", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::str(to_string(s.push_weighting)); }},
-      {"step", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::float_(s.step); }},
-      {"max_iterations", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::int_(s.max_iterations); }},
-      {"warm_start", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::bool_(s.warm_start); }},
-      {"time_budget", [](const EstimatorParams&, const EstimatorSettings& s) -> py::object { return py::float_(s.time_budget); }},
-  };
-  return g;
-}
-
-void check_getters() {
-  const auto docs = estimator_settings_table().docs();
-  for (const auto& d : docs) {
-    if (getters().count(d.name) == 0) throw std::logic_error("ofv: estimator setting '" + d.name + "' has no Python getter");
+const SettingsTable<EstimatorParams>::Row& row_named(const std::string& name) {
+  for (const auto& row : estimator_settings_table().rows()) {
+    if (row.doc.name == name) return row;
   }
-  if (getters().size() != docs.size()) throw std::logic_error("ofv: a Python getter names no estimator setting");
+  throw std::invalid_argument("unknown parameter '" + name + "'");
 }
 
 py::object get_setting(const EstimatorParams& p, const std::string& name) {
-  return getters().at(name)(p, p.resolve());
+  const auto& row = row_named(name);
+  return typed_value(row.doc, row.get(p));
 }
 
 // Sets one setting through the table, then checks the ranges (resolve(), spec
@@ -83,12 +62,7 @@ EstimatorParams params_arg(const py::handle& base) {
                        py::str(py::type::of(base).attr("__name__")).cast<std::string>());
 }
 
-py::dict settings_dict(const EstimatorParams& p) {
-  const EstimatorSettings s = p.resolve();
-  py::dict out;
-  for (const auto& d : estimator_settings_table().docs()) out[py::str(d.name)] = getters().at(d.name)(p, s);
-  return out;
-}
+py::dict settings_dict(const EstimatorParams& p) { return typed_values(estimator_settings_table(), p); }
 
 nlohmann::ordered_json scalar_json(const py::handle& v) {
   if (PyBool_Check(v.ptr())) return v.cast<bool>();
@@ -161,12 +135,9 @@ nlohmann::ordered_json scene_json(const Scene& scene) {
   }
   nlohmann::ordered_json j = scene_to_json(scene);
   const Scene back = scene_from_json(nlohmann::json::parse(j.dump()), "scene");
-  const EstimatorSettings want = scene.params.resolve();
-  const EstimatorSettings got = back.params.resolve();
-  for (const auto& d : estimator_settings_table().docs()) {
-    const py::object a = getters().at(d.name)(scene.params, want);
-    const py::object b = getters().at(d.name)(back.params, got);
-    if (!a.equal(b)) j["params"][d.name] = scalar_json(a);
+  for (const auto& row : estimator_settings_table().rows()) {
+    const std::string want = row.get(scene.params);
+    if (row.get(back.params) != want) j["params"][row.doc.name] = scalar_json(typed_value(row.doc, want));
   }
   return j;
 }
@@ -185,7 +156,6 @@ std::string settings_class_doc() {
 }  // namespace
 
 void bind_estimator(py::module_& m) {
-  check_getters();
 
   py::enum_<ViewStatus> status(m, "ViewStatus",
                                "Outcome of one estimate (spec §4, §8); a member's name is its word in "
@@ -437,7 +407,8 @@ PYBIND11_MODULE(_ofv, m) {
       PyErr_SetString(PyExc_RuntimeError, e.what());
     }
   });
-  m.attr("__version__") = OFV_VERSION;
+  m.attr("__version__") = ofv::version();
+  m.attr("git_commit") = ofv::git_commit();
   ofv::python::bind_estimator(m);
 #ifdef OFV_HAVE_LOOP
   ofv::python::bind_simulation(m);

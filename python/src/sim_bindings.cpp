@@ -124,6 +124,7 @@ struct ScratchDir {
 struct CallbackAborted {};
 
 struct Episode {
+  py::dict settings;  ///< every setting of the episode, resolved
   py::object metrics;
   py::dict trajectory;
   std::string out;                 ///< the folder of the files, '' when none were kept
@@ -192,6 +193,7 @@ Episode simulate(const py::object& scenario_obj, const py::object& out, bool pic
   if (aborted) throw *error;
 
   Episode result;
+  result.settings = typed_values(episode_settings_table(), setup);
   {
     std::ifstream in(fs::path(dir) / "metrics.json", std::ios::binary);
     std::stringstream text;
@@ -440,6 +442,9 @@ void bind_simulation(py::module_& m) {
         "type, default, unit and doc.");
 
   py::class_<Episode>(m, "Episode", "A closed-loop episode's results, as `ofv simulate` writes them.")
+      .def_readonly("settings", &Episode::settings,
+                    "every setting the episode ran with, resolved (the scenario's, then the keywords), by the\n"
+                    "names of episode_settings(): simulate(scenario, **episode.settings) runs it again")
       .def_readonly("metrics", &Episode::metrics, "metrics.json as a dict (same keys and values)")
       .def_readonly("trajectory", &Episode::trajectory,
                     "trajectory.csv as a dict of numpy columns (same names and values; float64, NaN for an empty\n"

@@ -83,6 +83,18 @@ def test_the_callback_sees_every_row_of_the_trajectory():
             assert column.tolist() == values
 
 
+def test_the_episodes_settings_run_it_again():
+    episode = ofv.simulate("dvd-two-hands", duration=0.3, perception="ground-truth", gain=3, preset="authors_code")
+    s = episode.settings
+    assert (s["duration"], s["perception"], s["gain"], s["preset"], s["step"]) == (0.3, "ground-truth", 3.0, "authors_code", 0.01)
+    assert list(s) == [d["name"] for d in ofv.episode_settings()]
+    again = ofv.simulate("dvd-two-hands", **s)
+    assert again.settings == s
+    for name, column in episode.trajectory.items():
+        if name not in TIMING_COLUMNS:
+            np.testing.assert_array_equal(again.trajectory[name], column, err_msg=name)
+
+
 def test_an_exception_in_the_callback_ends_the_episode_and_propagates():
     seen = []
 
