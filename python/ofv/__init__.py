@@ -34,6 +34,7 @@ from ._ofv import (
     ViewStatus,
     __version__,
     estimate_view,
+    git_commit,
     estimator_settings,
 )
 from ._tables import read_csv_columns
@@ -48,6 +49,7 @@ __all__ = [
     "__version__",
     "estimate_view",
     "estimator_settings",
+    "git_commit",
     "load_scene",
     "save_scene",
 ]
