@@ -56,6 +56,15 @@ std::string path_arg(const py::handle& obj, const std::string& name) {
                        py::str(py::type::of(obj).attr("__name__")).cast<std::string>());
 }
 
+// A Python int or numpy integer, not a bool.
+bool is_integer(const py::handle& h) {
+  return PyIndex_Check(h.ptr()) && !PyBool_Check(h.ptr()) && !py::isinstance<py::array>(h);
+}
+
+long long integer(const py::handle& h) {
+  return py::reinterpret_steal<py::object>(PyNumber_Index(h.ptr())).cast<long long>();
+}
+
 py::array_t<double> pose_matrix(const Eigen::Isometry3d& wMc) { return matrix_to_numpy(Eigen::MatrixXd(wMc.matrix())); }
 
 py::dict intrinsics_dict(const CameraIntrinsics& k) {
@@ -273,10 +282,9 @@ Frame render(const py::object& scenario_obj, double time, const py::object& pose
       throw py::type_error("size: expected (width, height)");
     }
     const auto wh = py::reinterpret_borrow<py::sequence>(size);
-    const bool ints = py::len(wh) == 2 && PyLong_Check(wh[0].ptr()) && PyLong_Check(wh[1].ptr()) &&
-                      !PyBool_Check(wh[0].ptr()) && !PyBool_Check(wh[1].ptr());
-    const long w = ints ? wh[0].cast<long>() : 0;
-    const long h = ints ? wh[1].cast<long>() : 0;
+    const bool ints = py::len(wh) == 2 && is_integer(wh[0]) && is_integer(wh[1]);
+    const long long w = ints ? integer(wh[0]) : 0;
+    const long long h = ints ? integer(wh[1]) : 0;
     if (w < 8 || h < 8 || w > 4096 || h > 4096) {
       throw py::value_error("size: expected (width, height), integers in [8, 4096], got " +
                             py::repr(size).cast<std::string>());
@@ -336,11 +344,11 @@ py::dict compare(const py::object& scenarios, const py::object& grid_obj, const 
   if (args.empty()) throw py::value_error("scenarios: expected at least one scenario");
   auto int_arg = [](const py::object& v, const std::string& name, int hi) -> std::optional<int> {
     if (v.is_none()) return std::nullopt;
-    if (!PyLong_Check(v.ptr()) || PyBool_Check(v.ptr()) || v.cast<long long>() < 1 || v.cast<long long>() > hi) {
+    if (!is_integer(v) || integer(v) < 1 || integer(v) > hi) {
       throw py::value_error(name + ": expected an integer in 1.." + std::to_string(hi) + ", got " +
                             py::repr(v).cast<std::string>());
     }
-    return v.cast<int>();
+    return static_cast<int>(integer(v));
   };
   const auto n_seeds = int_arg(seeds, "seeds", kMaxSeeds);
   const auto n_jobs = int_arg(jobs, "jobs", kMaxJobs);

@@ -50,7 +50,7 @@ def test_render_pose_as_matrix_or_theta_u_and_size(tmp_path, run_cli):
     small = ofv.render("dvd-static", 0.0, pose, size=(64, 48), out=tmp_path / "py")
     assert small.depth.shape == (48, 64)
     assert (tmp_path / "py" / "colour.png").read_bytes() == (tmp_path / "cli" / "colour.png").read_bytes()
-    as_matrix = ofv.render("dvd-static", 0.0, small.wMc, size=[64, 48])
+    as_matrix = ofv.render("dvd-static", 0.0, small.wMc, size=[np.int64(64), 48])
     np.testing.assert_array_equal(as_matrix.colour, small.colour)
     np.testing.assert_allclose(small.wMc[:3, 3], pose[:3])
 
@@ -65,6 +65,7 @@ def test_render_pose_as_matrix_or_theta_u_and_size(tmp_path, run_cli):
     ({"pose": np.eye(4, dtype=np.int64)}, TypeError, "pose: expected a float64 array"),
     ({"size": (4, 4)}, ValueError, r"size: expected \(width, height\), integers in \[8, 4096\]"),
     ({"size": (64.0, 48)}, ValueError, "size: expected"),
+    ({"size": (True, 48)}, ValueError, "size: expected"),
 ])
 def test_bad_render_arguments_are_refused(kwargs, error, message):
     args = {"time": 0.0, **kwargs}
