@@ -24,6 +24,12 @@ if(loop IN_LIST _ofv_components)
   list(APPEND _ofv_deb_depends libyaml-cpp-dev)
 endif()
 list(APPEND _ofv_deb_depends gnuplot-nox)  # `ofv compare` plots
+if(TARGET ofv_python)
+  # The module ofv in /usr/lib/python3/dist-packages: built for one CPython
+  # minor version (its extension's ABI), numpy at run time.
+  math(EXPR _ofv_py_next "${Python3_VERSION_MINOR} + 1")
+  list(APPEND _ofv_deb_depends "python3 (>= 3.${Python3_VERSION_MINOR})" "python3 (<< 3.${_ofv_py_next})" python3-numpy)
+endif()
 list(REMOVE_DUPLICATES _ofv_deb_depends)
 list(JOIN _ofv_deb_depends ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
 
@@ -35,8 +41,9 @@ set(CPACK_PACKAGE_DESCRIPTION
     "ofv estimates occlusion-free views of an object from RGB-D frames and\n"
     "servoes a camera to them with ViSP. The package holds the ofv program,\n"
     "the libraries (core, io, perception, sim, servo, loop, display) with their\n"
-    "headers and CMake package (find_package(ofv COMPONENTS ...)), and the\n"
-    "built-in scenarios and examples in /usr/share/ofv.")
+    "headers and CMake package (find_package(ofv COMPONENTS ...)), the\n"
+    "built-in scenarios and examples in /usr/share/ofv, and (when built) the\n"
+    "Python module ofv (import ofv).")
 list(JOIN CPACK_PACKAGE_DESCRIPTION "" CPACK_PACKAGE_DESCRIPTION)
 set(CPACK_PACKAGE_CONTACT "ofv maintainers <ofv@localhost>")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
