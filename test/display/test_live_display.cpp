@@ -273,8 +273,7 @@ TEST(LiveDisplay, ALoopOfOnesOwnAndHoursOfCurves) {
     in.time = 10.0 * k;
     in.centroid = Eigen::Vector3d(0, 0, 0.5);
     in.target = Eigen::Vector3d(0.25, 0, 0.5 - 0.433);
-    in.velocity.emplace(6, 0.0);
-    (*in.velocity)[0] = 0.01 * k;
+    in.velocity = vpColVector{0.01 * k, 0, 0, 0, 0, 0};
     ASSERT_TRUE(display.show(in));
   }
   vpImage<vpRGBa> camera;
