@@ -64,13 +64,6 @@ EstimatorParams params_arg(const py::handle& base) {
 
 py::dict settings_dict(const EstimatorParams& p) { return typed_values(estimator_settings_table(), p); }
 
-nlohmann::ordered_json scalar_json(const py::handle& v) {
-  if (PyBool_Check(v.ptr())) return v.cast<bool>();
-  if (PyLong_Check(v.ptr())) return v.cast<long long>();
-  if (PyFloat_Check(v.ptr())) return v.cast<double>();
-  return v.cast<std::string>();
-}
-
 // --- Scene: a scene file of `ofv estimate` (scene_json.h) and where it came from.
 
 struct PyScene {
@@ -133,13 +126,7 @@ nlohmann::ordered_json scene_json(const Scene& scene) {
     throw py::value_error("normals: expected one normal per position (" + std::to_string(pb.positions.cols()) +
                           "), got " + std::to_string(pb.normals.cols()));
   }
-  nlohmann::ordered_json j = scene_to_json(scene);
-  const Scene back = scene_from_json(nlohmann::json::parse(j.dump()), "scene");
-  for (const auto& row : estimator_settings_table().rows()) {
-    const std::string want = row.get(scene.params);
-    if (row.get(back.params) != want) j["params"][row.doc.name] = scalar_json(typed_value(row.doc, want));
-  }
-  return j;
+  return scene_to_json(scene);
 }
 
 std::string settings_class_doc() {

@@ -324,6 +324,7 @@ ordered_json scene_to_json(const Scene& scene) {
   if (p.step) params["step"] = *p.step;
   if (p.max_iterations) params["max_iterations"] = *p.max_iterations;
   if (p.warm_start) params["warm_start"] = *p.warm_start;
+  if (p.time_budget) params["time_budget"] = *p.time_budget;
   j["params"] = params;
   return j;
 }
