@@ -279,12 +279,16 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
   // Rows in parallel; noise needs the clean depth of the neighbour rows, so it
   // is a second parallel pass.
   const int threads = std::max(1, std::min<int>(static_cast<int>(std::thread::hardware_concurrency()), 8));
+  // Bands of kBand rows dealt out in turn, so that each thread gets as much
+  // of the scene as of the empty sky above it.
+  constexpr int kBand = 8;
   auto in_parallel = [&](const std::function<void(int, int)>& rows) {
+    const auto bands_of = [&](int t) {
+      for (int row0 = t * kBand; row0 < k.height; row0 += threads * kBand) rows(row0, std::min(row0 + kBand, k.height));
+    };
     std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) {
-      pool.emplace_back(rows, k.height * t / threads, k.height * (t + 1) / threads);
-    }
-    rows(0, k.height / threads);
+    for (int t = 1; t < threads; ++t) pool.emplace_back(bands_of, t);
+    bands_of(0);
     for (auto& t : pool) t.join();
   };
   in_parallel(render_rows);

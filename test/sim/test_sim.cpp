@@ -330,5 +330,27 @@ TEST(Renderer, NoiseIsDeterministicPerFrame) {
   EXPECT_LT(missing, valid / 5);     // but most of the image is there
 }
 
+TEST(Renderer, AFrameRenderedIntoAnotherIsTheFrameRenderedAfresh) {
+  // The loop renders each frame into the memory of the one before (other
+  // pose, size, time and noise): nothing of it may show through.
+  const Scenario s = load_scenario("dvd-one-hand");
+  Renderer r(s);
+  r.set_time(2.0);
+  Eigen::Isometry3d aside = s.wMc_start;
+  aside.translation() += Eigen::Vector3d(0.1, -0.05, 0.02);
+  const CameraIntrinsics big = intrinsics_preset("d435-640"), small = s.sensor.intrinsics;
+  RenderedFrame reused;
+  r.render(aside, 7, big, true, reused);
+  for (const auto& [k, noise] : {std::pair{small, true}, std::pair{big, false}, std::pair{small, false}}) {
+    r.set_time(r.time() + 0.5);
+    const RenderedFrame fresh = r.render(s.wMc_start, 8, k, noise);
+    r.render(s.wMc_start, 8, k, noise, reused);
+    EXPECT_EQ(reused.frame.depth, fresh.frame.depth);
+    EXPECT_EQ(reused.frame.rgb, fresh.frame.rgb);
+    EXPECT_EQ(reused.labels, fresh.labels);
+    EXPECT_EQ(reused.frame.intrinsics.width, k.width);
+  }
+}
+
 }  // namespace
 }  // namespace ofv::sim
