@@ -3,8 +3,8 @@
 # compare` with --jobs 1 and --jobs 2, and as a Slurm job array of 1 and of
 # N tasks (one CPU each) on a single-node cluster brought up here
 # (scripts/slurm-local.sh; needs root, slurm-wlm and munge). Each way runs
-# the same sweep from scratch: 4 scenarios x 2 variants x SEEDS seeds, 2 s
-# episodes with full perception (the loop as `ofv simulate` runs it).
+# the same sweep from scratch: 4 scenarios x 2 variants x SEEDS seeds (each
+# scenario's own length, 4 to 5 s) with full perception, as `ofv simulate` runs.
 #
 #   scripts/sweep-throughput.sh [SEEDS [N]]     (defaults: 2 seeds, N = nproc)
 set -euo pipefail
@@ -19,7 +19,6 @@ trap 'scripts/slurm-local.sh down >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
 cat > "$work/grid.yaml" <<GRID
 name: throughput
 seeds: $seeds
-set: {duration: 2}
 variants:
   - {name: ofv, set: {}}
   - {name: static, set: {method: static}}
