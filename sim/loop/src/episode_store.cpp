@@ -198,6 +198,9 @@ SweepRecord read_record(const fs::path& file) {
       s.variant.settings = settings_from_json(v.at("settings"));
       s.seed = e.at(2).get<int>();
       s.index = e.at(3).get<int>();
+      if (s.index != static_cast<int>(r.plan.size())) {
+        throw std::runtime_error("episode " + std::to_string(r.plan.size()) + " has index " + std::to_string(s.index));
+      }
       r.plan.push_back(std::move(s));
     }
     if (plan_fingerprint(r.plan) != j.at("fingerprint").get<std::string>()) {
@@ -307,6 +310,7 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
   std::vector<Part> parts;
   parts.reserve(dirs.size());  // `planned` points into the first part's plan
   std::map<std::string, const EpisodeSpec*> planned;  // id -> the plan's episode
+  std::vector<int> run_by;                            // episode index -> the part that runs it
   std::set<std::string> found;
   for (const auto& d : dirs) {
     const fs::path dir = fs::path(d) / "episodes";
@@ -320,30 +324,36 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
     if (parts.size() == 1) {
       for (const auto& s : part.sweep.plan) planned.emplace(s.id(), &s);
     }
-    for (std::size_t other = 0; other + 1 < parts.size(); ++other) {
-      const Part& earlier = parts[other];
-      const std::string both = earlier.record.string() + " and " + record.string();
-      const std::string diff = plan_difference(earlier.sweep.plan, part.sweep.plan);
+    if (parts.size() > 1) {  // the same sweep and ofv as the first part, so as every other
+      const Part& first = parts.front();
+      const std::string both = first.record.string() + " and " + record.string();
+      const std::string diff = plan_difference(first.sweep.plan, part.sweep.plan);
       if (!diff.empty()) throw std::invalid_argument(both + ": parts of different sweeps (" + diff + ")");
-      if (earlier.sweep.ofv != part.sweep.ofv) {
-        throw std::invalid_argument(both + ": parts run by different ofv (" + earlier.sweep.ofv + " there, " +
+      if (first.sweep.ofv != part.sweep.ofv) {
+        throw std::invalid_argument(both + ": parts run by different ofv (" + first.sweep.ofv + " there, " +
                                     part.sweep.ofv + " here): results of other code are not mixed");
       }
-      const Shard a = earlier.sweep.part, b = part.sweep.part;
-      for (const auto& s : part.sweep.plan) {
-        if (s.index % a.n == a.k - 1 && s.index % b.n == b.k - 1) {
-          throw std::invalid_argument(both + ": parts " + part_text(a) + " and " + part_text(b) +
-                                      " overlap (both run episode " + std::to_string(s.index) + ", " + s.id() +
-                                      "): merge parts that share no episode");
-        }
+    }
+    // No episode in two parts: each remembers the part that runs it.
+    const Shard mine = part.sweep.part;
+    for (const auto& s : part.sweep.plan) {
+      if (s.index % mine.n != mine.k - 1) continue;
+      if (static_cast<std::size_t>(s.index) >= run_by.size()) run_by.resize(static_cast<std::size_t>(s.index) + 1, -1);
+      int& owner = run_by[static_cast<std::size_t>(s.index)];
+      if (owner >= 0) {
+        const Part& earlier = parts[static_cast<std::size_t>(owner)];
+        throw std::invalid_argument(earlier.record.string() + " and " + record.string() + ": parts " +
+                                    part_text(earlier.sweep.part) + " and " + part_text(mine) +
+                                    " overlap (both run episode " + std::to_string(s.index) + ", " + s.id() +
+                                    "): merge parts that share no episode");
       }
+      owner = static_cast<int>(parts.size() - 1);
     }
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(dir)) {
       if (e.path().extension() == ".json") files.push_back(e.path());
     }
     std::sort(files.begin(), files.end());
-    const Shard mine = part.sweep.part;
     for (const auto& f : files) {
       auto [spec, j] = read_episode(f);
       const auto plan = planned.find(spec.id());
