@@ -388,21 +388,41 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
   return tracks_;
 }
 
+bool is_moving(const OccluderTrack& track, double min_speed) {
+  return track.confirmed && track.points.cols() > 0 && track.velocity.norm() > min_speed;
+}
+
 Eigen::Matrix3Xd predicted_occluders(const std::vector<OccluderTrack>& tracks, const std::vector<double>& times,
                                      double min_speed) {
   Eigen::Index count = 0;
-  const auto moving = [&](const OccluderTrack& t) {
-    return t.confirmed && t.points.cols() > 0 && t.velocity.norm() > min_speed;
-  };
-  for (const OccluderTrack& t : tracks) count += moving(t) ? t.points.cols() * static_cast<Eigen::Index>(times.size()) : 0;
+  for (const OccluderTrack& t : tracks) {
+    count += is_moving(t, min_speed) ? t.points.cols() * static_cast<Eigen::Index>(times.size()) : 0;
+  }
   Eigen::Matrix3Xd out(3, count);
   Eigen::Index k = 0;
   for (const OccluderTrack& t : tracks) {
-    if (!moving(t)) continue;
+    if (!is_moving(t, min_speed)) continue;
     for (const double tau : times) {
       out.middleCols(k, t.points.cols()) = t.points.colwise() + tau * t.velocity;
       k += t.points.cols();
     }
+  }
+  return out;
+}
+
+bool is_still(const OccluderTrack& track, double min_speed) {
+  return track.confirmed && track.points.cols() > 0 && !(track.velocity.norm() > min_speed);
+}
+
+Eigen::Matrix3Xd still_occluders(const std::vector<OccluderTrack>& tracks, double min_speed) {
+  Eigen::Index count = 0;
+  for (const OccluderTrack& t : tracks) count += is_still(t, min_speed) ? t.points.cols() : 0;
+  Eigen::Matrix3Xd out(3, count);
+  Eigen::Index k = 0;
+  for (const OccluderTrack& t : tracks) {
+    if (!is_still(t, min_speed)) continue;
+    out.middleCols(k, t.points.cols()) = t.points;
+    k += t.points.cols();
   }
   return out;
 }

@@ -125,4 +125,15 @@ class OccluderTracker {
 [[nodiscard]] Eigen::Matrix3Xd predicted_occluders(const std::vector<OccluderTrack>& tracks,
                                                    const std::vector<double>& times, double min_speed);
 
+/// \brief True for a confirmed track seen this frame and moving faster than
+///        `min_speed` [m/s] (the tracks predicted_occluders() moves).
+[[nodiscard]] bool is_moving(const OccluderTrack& track, double min_speed);
+
+/// \brief True for a confirmed track seen this frame and moving no faster
+///        than `min_speed` [m/s]: known to stand still (a new track is not yet).
+[[nodiscard]] bool is_still(const OccluderTrack& track, double min_speed);
+
+/// \brief This frame's points of the tracks that stand still (is_still()).
+[[nodiscard]] Eigen::Matrix3Xd still_occluders(const std::vector<OccluderTrack>& tracks, double min_speed);
+
 }  // namespace ofv

@@ -255,26 +255,30 @@ void ViewLoop::reset() {
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, const ViewEstimate& estimate,
-                                                 double shown, const std::optional<Eigen::Vector3d>& target) {
+                                                 double shown, double dt, const std::optional<Eigen::Vector3d>& target) {
   const NoFreeViewSettings& s = settings_.no_free_view;
   const Eigen::Vector3d& c = estimate.centroid;
   const Eigen::Vector3d& here = *problem.camera;
   if (s.retreat_drop <= 0.0) return target;
   constexpr double kAway = 0.01;  // [m]: the camera has moved from a view
   constexpr int kFrames = 2;      // a loss counts when it lasts this many frames (one frame is noise)
-  constexpr int kReleaseFrames = 16;  // back at the held view, this many frames showing less release it
+  constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
+  constexpr double kEvidence = 0.5;  // [s]
   const double keep = 1.0 - s.retreat_drop;
   if (held_) {
     const bool there = (here - held_->position).norm() <= kAway;
     low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
     if (estimate.iterations > 0 && low_frames_ < kReleaseFrames) return held_->position;
     held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
-    best_seen_ = SeenView{here, shown};
+    best_seen_ = SeenView{here, shown, problem.occluders};
     low_frames_ = 0;
     return target;
   }
-  if (!best_seen_ || shown >= best_seen_->shown) {
-    best_seen_ = SeenView{here, shown};
+  if (best_seen_) best_seen_->age += dt;
+  // What a view showed longer ago than kEvidence is no evidence any more
+  // (the occluders move): the current view starts again.
+  if (!best_seen_ || shown >= best_seen_->shown || !(best_seen_->age <= kEvidence)) {
+    best_seen_ = SeenView{here, shown, problem.occluders};
     low_frames_ = 0;
     return target;
   }
@@ -282,14 +286,24 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   low_frames_ = away && shown < keep * best_seen_->shown ? low_frames_ + 1 : 0;
   if (low_frames_ < kFrames) return target;
   const double r = estimator_.r_sphere;
-  const auto score = [&](const Eigen::Vector3d& p) {
-    return score_view(problem, c, r, c + r * (p - c).normalized(), s.occluder_radius).visible_fraction;
+  const auto score = [&](const ViewProblem& scene, const Eigen::Vector3d& p) {
+    return score_view(scene, c, r, c + r * (p - c).normalized(), s.occluder_radius).visible_fraction;
   };
+  // The loss must come from the camera's own motion: with the occluders as
+  // they were when that view showed the most, and those of this frame known
+  // to stand still (revealed by the motion), here shows less than there by
+  // retreat_drop too. Occluders that moved in since cost the object
+  // wherever the camera is.
+  const Eigen::Matrix3Xd still = still_occluders(tracker_.tracks(), settings_.anticipation.min_speed);
+  ViewProblem then = problem;
+  then.occluders.resize(3, best_seen_->occluders.cols() + still.cols());
+  then.occluders << best_seen_->occluders, still;
+  if (!(score(then, here) < keep * score(then, best_seen_->position))) return target;
   // The frame's occluders must make that view clearly better, or at least
   // not worse where they hide most of the object from here.
-  const double here_score = score(here);
+  const double here_score = score(problem, here);
   const double margin = here_score < 0.5 ? 0.0 : 0.1;
-  if (score(best_seen_->position) < here_score + margin) return target;  // the occluders came there too
+  if (score(problem, best_seen_->position) < here_score + margin) return target;  // the occluders came there too
   held_ = best_seen_;
   low_frames_ = 0;
   return held_->position;
@@ -387,7 +401,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
       }
     }
     out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate);
-    if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, *out.estimate, *shown, out.target);
+    if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, *out.estimate, *shown, dt, out.target);
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
   }

@@ -4,6 +4,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
 #include <limits>
 #include <vector>
 
@@ -49,6 +53,58 @@ OrientedBox augmented_obb(const std::vector<Eigen::Vector3d>& points, const Eige
 }
 
 }  // namespace
+
+void Perception::Impl::hidden_vertices(ViewProblem& p, std::size_t seen) const {
+  // The hidden voxels grouped as the supervoxels of the seen part are, by
+  // place and by surface: per cell of the seed resolution and per facing
+  // (the axis and sign of the largest component of the normal their
+  // supervoxel had), a vertex at their mean with their mean normal, when the
+  // group holds at least a quarter of a cell's face of voxels.
+  const double seed = settings.supervoxels.seed_resolution;
+  const double per_side = seed / settings.supervoxels.voxel_resolution;
+  const auto min_voxels =
+      static_cast<std::size_t>(std::max(1.0, std::floor(0.25 * per_side * per_side)));
+  using Key = Eigen::Matrix<int, 4, 1>;  // cell x, y, z; facing 0..5
+  std::vector<std::pair<Key, std::size_t>> groups;
+  for (std::size_t i = 0; i < memory.size(); ++i) {
+    const Eigen::Vector3f& n = memory_normal[i];
+    if (memory_age[i] == 0 || n.isZero()) continue;
+    Eigen::Index axis = 0;
+    n.cwiseAbs().maxCoeff(&axis);
+    Key key;
+    key.head<3>() = (memory[i].cast<double>() / seed).array().floor().cast<int>();
+    key(3) = 2 * static_cast<int>(axis) + (n(axis) < 0.0f ? 1 : 0);
+    groups.emplace_back(key, i);
+  }
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+    return std::lexicographical_compare(a.first.data(), a.first.data() + 4, b.first.data(),
+                                        b.first.data() + 4) ||
+           (a.first == b.first && a.second < b.second);
+  });
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> found;  // position, normal
+  for (std::size_t a = 0; a < groups.size();) {
+    std::size_t b = a;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (; b < groups.size() && groups[b].first == groups[a].first; ++b) {
+      position += memory[groups[b].second].cast<double>();
+      normal += memory_normal[groups[b].second].cast<double>();
+    }
+    const std::size_t count = b - a;
+    a = b;
+    if (count >= min_voxels && normal.norm() > 1e-6) {
+      found.emplace_back(position / static_cast<double>(count), normal.normalized());
+    }
+  }
+  const auto k = static_cast<Eigen::Index>(seen);
+  const auto n = static_cast<Eigen::Index>(found.size());
+  p.positions.conservativeResize(3, k + n);
+  p.normals.conservativeResize(3, k + n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    p.positions.col(k + j) = found[static_cast<std::size_t>(j)].first;
+    p.normals.col(k + j) = found[static_cast<std::size_t>(j)].second;
+  }
+}
 
 void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& object) {
   const std::size_t n = r.supervoxels.size();
@@ -109,23 +165,11 @@ void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& ob
     p.normals.col(static_cast<Eigen::Index>(j)) = s.normal;
   }
   if (settings.tracking.hidden_vertices) {
-    // The object's remembered supervoxels now hidden: the estimator keeps
-    // them in view too, not only the part that is still seen.
-    Eigen::Index k = p.positions.cols();
-    for (const Vertex& m : vertex_memory) {
-      k += m.age > 0 ? 1 : 0;
-    }
-    p.positions.conservativeResize(3, k);
-    p.normals.conservativeResize(3, k);
-    k = static_cast<Eigen::Index>(vertices.size());
-    for (const Vertex& m : vertex_memory) {
-      if (m.age == 0) continue;
-      p.positions.col(k) = m.centroid;
-      p.normals.col(k) = m.normal;
-      ++k;
-    }
-    r.counts.hidden_vertices = static_cast<std::size_t>(k) - vertices.size();
+    // The object's remembered part now hidden: the estimator keeps it in
+    // view too, not only the part that is still seen.
+    hidden_vertices(p, vertices.size());
   }
+  r.counts.hidden_vertices = static_cast<std::size_t>(p.positions.cols()) - vertices.size();
   p.occluders.resize(3, static_cast<Eigen::Index>(occluders.size()));
   for (std::size_t j = 0; j < occluders.size(); ++j) {
     p.occluders.col(static_cast<Eigen::Index>(j)) =

@@ -46,20 +46,25 @@ inline std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eige
   return Eigen::Vector2d(k.fx * pc.x() / pc.z() + k.cx, k.fy * pc.y() / pc.z() + k.cy);
 }
 
-/// True when world point p cannot be seen in the frame: out of the image, or
-/// behind a surface nearer the camera by more than `tolerance` [m].
-inline bool hidden(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
+/// What the frame shows of world point p.
+enum class Sight {
+  Shown,    ///< its pixel's depth is at p or behind it
+  Hidden,   ///< out of the image, or behind a surface nearer the camera by more than the tolerance
+  NoDepth,  ///< its pixel has no depth (a drop-out, or a sensor's shadow next to an occluding edge)
+};
+
+inline Sight sight(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
                    double tolerance) {
   double z = 0.0;
   const auto px = project(frame, cMw, p, &z);
-  if (!px) return true;
+  if (!px) return Sight::Hidden;
   const int u = static_cast<int>(std::lround(px->x()));
   const int v = static_cast<int>(std::lround(px->y()));
   const CameraIntrinsics& k = frame.intrinsics;
-  if (u < 0 || v < 0 || u >= k.width || v >= k.height) return true;
+  if (u < 0 || v < 0 || u >= k.width || v >= k.height) return Sight::Hidden;
   const float observed = frame.depth[frame.index(u, v)];
-  return std::isfinite(observed) && observed > 0.0f &&
-         static_cast<double>(observed) < z - tolerance;
+  if (!(std::isfinite(observed) && observed > 0.0f)) return Sight::NoDepth;
+  return static_cast<double>(observed) < z - tolerance ? Sight::Hidden : Sight::Shown;
 }
 
 }  // namespace detail
@@ -103,11 +108,8 @@ struct Perception::Impl {
   std::vector<Eigen::Vector3f> memory;  // object voxels: seen now, or hidden behind something
   std::vector<Eigen::Vector3f> memory_chroma;  // chromaticity of each memory voxel
   std::vector<int> memory_age;                 // frames since the voxel was last seen
-  struct Vertex {
-    Eigen::Vector3d centroid, normal;
-    int age = 0;  // frames since it was last seen
-  };
-  std::vector<Vertex> vertex_memory;     // object supervoxels: seen now, or hidden behind something
+  std::vector<Eigen::Vector3f> memory_normal;  // its supervoxel's normal then (0: none)
+  detail::PointGrid seen_grid;                 // the frame's object voxels (remember())
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
   std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
@@ -159,6 +161,9 @@ struct Perception::Impl {
   void remember(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<char>& object);
   /// classify.cpp: C, axes, OBB, labels and r.problem.
   void classify(PerceptionResult& r, const std::vector<char>& object);
+  /// classify.cpp: the remembered hidden voxels as vertices of p, after its
+  /// `seen` columns (TrackingSettings::hidden_vertices).
+  void hidden_vertices(ViewProblem& p, std::size_t seen) const;
 };
 
 }  // namespace ofv

@@ -247,59 +247,58 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
 
 void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& r,
                                 const std::vector<char>& object) {
-  // Old object voxels now hidden behind something nearer the camera (or out
-  // of the image) stay in the state for a while, so that the object's
-  // occluded part is recognised when it reappears.
+  // Old object voxels not seen in this frame (behind something nearer the
+  // camera, out of the image, or on a pixel with no depth away from the seen
+  // surface) stay in the state
+  // for a while, so that the object's occluded part is recognised when it
+  // reappears and stays part of the object (classify()).
   // They follow the object's motion, estimated from what is seen of it.
   const Eigen::Isometry3d motion = object_motion(frame, r, object);
   const Eigen::Isometry3f motion_f = motion.cast<float>();
   std::vector<Eigen::Vector3f> next;
   std::vector<Eigen::Vector3f> next_chroma;
   std::vector<int> next_age;
+  std::vector<Eigen::Vector3f> next_normal;
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     if (object[owner] && voxel_matched[i]) {
+      const SupervoxelInfo& s = r.supervoxels[owner];
       next.push_back(r.voxels[i]);
       next_chroma.push_back(chroma(sv.colours[i]));
       next_age.push_back(0);
+      next_normal.push_back(s.normal_valid ? Eigen::Vector3f(s.normal.cast<float>())
+                                           : Eigen::Vector3f::Zero());
     }
   }
   const Eigen::Isometry3d cMw = frame.wMc.inverse();
   const double tolerance = settings.tracking.max_motion;
   const int max_age = settings.tracking.occlusion_memory_frames;
+  // A pixel with no depth hides the voxel only when the frame does not show
+  // the same voxel (within half a voxel) through other pixels: a drop-out
+  // amid the seen surface does not hide it.
+  const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
+  seen_grid.build(next, res);
+  const auto unseen = [&](const Eigen::Vector3f& p) {
+    switch (detail::sight(frame, cMw, p.cast<double>(), tolerance)) {
+      case detail::Sight::Hidden: return true;
+      case detail::Sight::NoDepth: return !seen_grid.any_within(p, 0.5f * res, [](int) { return true; });
+      case detail::Sight::Shown: return false;
+    }
+    return false;
+  };
   for (std::size_t i = 0; i < memory.size(); ++i) {
     memory[i] = motion_f * memory[i];
-    if (memory_age[i] + 1 <= max_age &&
-        detail::hidden(frame, cMw, memory[i].cast<double>(), tolerance)) {
+    if (memory_age[i] + 1 <= max_age && unseen(memory[i])) {
       next.push_back(memory[i]);
       next_chroma.push_back(memory_chroma[i]);
       next_age.push_back(memory_age[i] + 1);
+      next_normal.push_back(motion_f.linear() * memory_normal[i]);
     }
   }
   memory.swap(next);
   memory_chroma.swap(next_chroma);
   memory_age.swap(next_age);
-
-  // The same for the object's supervoxels (the estimator's vertices). A
-  // remembered vertex goes when it shows again or a seen one takes its place.
-  std::vector<Vertex> vertices;
-  for (std::size_t i = 0; i < r.supervoxels.size(); ++i) {
-    if (object[i] && r.supervoxels[i].normal_valid) {
-      vertices.push_back({r.supervoxels[i].centroid, r.supervoxels[i].normal, 0});
-    }
-  }
-  const std::size_t seen = vertices.size();
-  const double spacing = 0.5 * settings.supervoxels.seed_resolution;
-  for (Vertex& m : vertex_memory) {
-    m.centroid = motion * m.centroid;
-    m.normal = motion.linear() * m.normal;
-    if (m.age + 1 > max_age || !detail::hidden(frame, cMw, m.centroid, tolerance)) continue;
-    const bool replaced =
-        std::any_of(vertices.begin(), vertices.begin() + static_cast<std::ptrdiff_t>(seen),
-                    [&](const Vertex& v) { return (v.centroid - m.centroid).norm() < spacing; });
-    if (!replaced) vertices.push_back({m.centroid, m.normal, m.age + 1});
-  }
-  vertex_memory.swap(vertices);
+  memory_normal.swap(next_normal);
 }
 
 }  // namespace ofv

@@ -139,7 +139,7 @@ void Perception::reset() {
   impl_->memory.clear();
   impl_->memory_chroma.clear();
   impl_->memory_age.clear();
-  impl_->vertex_memory.clear();
+  impl_->memory_normal.clear();
   impl_->previous_outline.clear();
   impl_->previous_outline_normals.clear();
   impl_->initial_voxels = 0;

@@ -90,7 +90,7 @@ struct TrackingSettings {
   /// drift. false (default): hidden parts stay where they were last seen.
   /// Off by default: on the simulator's moving-object scenario it did not
   /// raise the visible fraction (see docs/perception.md).
-  bool follow_motion = false;
+  bool follow_motion = true;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
   /// this distance, normal within 60 degrees) are never object: the table

@@ -154,12 +154,16 @@ class ViewLoop {
   [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate);
   [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
   [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, const ViewEstimate& estimate,
-                                                       double shown, const std::optional<Eigen::Vector3d>& target);
+                                                       double shown, double dt,
+                                                       const std::optional<Eigen::Vector3d>& target);
 
-  /// A camera position (world) and how much of the object it showed.
+  /// A camera position (world), how much of the object it showed, the
+  /// occluders of that frame, and how long ago that was.
   struct SeenView {
     Eigen::Vector3d position;
     double shown = 0.0;
+    Eigen::Matrix3Xd occluders;
+    double age = 0.0;  ///< time since [s]
   };
 
   LoopSettings settings_;
