@@ -352,8 +352,8 @@ class BufferCache {
         return std::move(s.buffer);
       }
     }
-    capacity = size;
-    return std::unique_ptr<double[]>(new double[size]);
+    capacity = size + size / 2;  // room to grow: fewer fresh buffers while problems grow
+    return std::unique_ptr<double[]>(new double[capacity]);
   }
   void give(std::unique_ptr<double[]> buffer, std::size_t size) {
     Slot* smallest = &slots_[0];
@@ -504,6 +504,44 @@ OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Ma
   rays.points.rows = (k + kLanes - 1) / kLanes;
   return rays;
 }
+
+// The last occlusion rays computed on this thread, with their inputs: a
+// loop that estimates the same problem again from another start (the warm
+// start from its previous target) gets them without computing them twice.
+// Only problems of up to kCachedRays points are kept (memory held per thread).
+class RaysCache {
+ public:
+  // The thread's BufferCache first, so that it outlives this cache (thread
+  // storage is destroyed in reverse order) and takes back the rays' buffer.
+  RaysCache() { (void)buffer_cache(); }
+
+  const OcclusionRays& get(const Eigen::Vector3d& c, double r, const Eigen::Matrix3Xd& v,
+                           const Eigen::Matrix3Xd& q) {
+    const bool same = valid_ && c == c_ && r == r_ && v.cols() == v_.cols() && q.cols() == q_.cols() &&
+                      v == v_ && q == q_;
+    if (!same) {
+      valid_ = false;
+      rays_.reset();  // its buffer back to the cache first
+      rays_.emplace(occlusion_rays(c, r, v, q));
+      if (static_cast<double>(v.cols()) * static_cast<double>(q.cols()) <= kCachedRays) {
+        c_ = c;
+        r_ = r;
+        v_ = v;
+        q_ = q;
+        valid_ = true;
+      }
+    }
+    return *rays_;
+  }
+
+ private:
+  static constexpr double kCachedRays = 1e6;
+  bool valid_ = false;
+  Eigen::Vector3d c_ = Eigen::Vector3d::Zero();
+  double r_ = 0.0;
+  Eigen::Matrix3Xd v_, q_;
+  std::optional<OcclusionRays> rays_;
+};
 
 // ---------------------------------------------------------------------------
 // §4: the iteration (eqs. 6-8).
@@ -917,7 +955,8 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
                   " occluders make " + format_value(n_rays) + " occlusion rays, more than the " +
                   format_value(kMaxOcclusionRays) + " ofv handles: thin the supervoxels or the occluders");
     }
-    const OcclusionRays occ = occlusion_rays(c, r, rays.v, q);
+    thread_local RaysCache cache;
+    const OcclusionRays& occ = cache.get(c, r, rays.v, q);
     est.occlusion_points = static_cast<int>(occ.size());
     const IterationResult it =
         iterate(occ, start, est.t0, object, settings, deadline, options.record_path ? &est.path : nullptr);
