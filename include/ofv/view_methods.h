@@ -96,13 +96,17 @@ struct NoFreeViewSettings {
   double occluder_radius = 0.02;  ///< an occluder point blocks lines of sight passing closer than this [m]
   /// Retreat (ofv::ViewLoop, told how much of the object each frame shows):
   /// the loop remembers the camera position that showed the most of the
-  /// object. When the camera has moved away from it and shows this fraction
-  /// of that less, and the frame's occluders (score_view) do not make that
-  /// position worse than the current one, the camera goes back there and
-  /// holds until t0 is clear again or, back there, it shows this fraction
-  /// less for 16 frames in a row (the scene changed). A target that only a partial perception believes clear (an
-  /// occluder hidden behind another) so cannot lead the camera into a cage
-  /// that hides the object. 0 = off.
+  /// object in the last 0.5 s. When the camera has moved away from it and
+  /// shows this fraction of that less for two frames, because of its own
+  /// motion (with the occluders of that position's frame and this frame's
+  /// still ones, score_view shows this fraction less here than there), and
+  /// this frame's occluders do not make that position worse than the
+  /// current one, the camera goes back there and holds until t0 is clear
+  /// again or, back there, it shows this fraction less for 6 frames in a
+  /// row (the scene changed). A target that only a partial perception
+  /// believes clear (an occluder hidden behind another) so cannot lead the
+  /// camera into a cage that hides the object, and occluders that move in
+  /// do not send it back into their way. 0 = off.
   double retreat_drop = 0.1;
 };
 

@@ -182,8 +182,9 @@ SettingsTable<LoopSettings> make_table() {
         },
         [](const L& l) { return std::string(to_string(l.no_free_view.mode)); });
   t.add({"retreat_drop", "number in [0, 1]", format_number(d.no_free_view.retreat_drop), "",
-         "the fraction of the object the camera may see less, after moving, than at the view it has been at that "
-         "showed the most, before it goes back there and holds (unless the occluders came there too), 0 (off) to 1"},
+         "the fraction of the object the camera may see less, because it moved, than at the view that showed the "
+         "most in the last 0.5 s, before it goes back there and holds (not when occluders moved in or came there "
+         "too), 0 (off) to 1"},
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
   t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",

@@ -2,9 +2,10 @@
 // one file each along the frame's path:
 //   pipeline.cpp          the per-frame sequence (cloud, supervoxels, adjacency, ...)
 //   object_selection.cpp  the first frame: support plane, then the object by box, image or cluster
-//   object_memory.cpp     later frames: the object found near its remembered voxels; the
-//                         memory updated, hidden voxels and supervoxels kept for a while
+//   object_memory.cpp     later frames: the object found near its remembered voxels, its
+//                         motion; the memory updated, hidden voxels kept (and moved) for a while
 //   classify.cpp          PCA, augmented OBB, interacting / occluders, the ViewProblem
+//                         (with vertices from the hidden voxels)
 #pragma once
 
 #include "ofv/perception/cloud.h"

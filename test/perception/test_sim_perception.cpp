@@ -138,14 +138,14 @@ TEST(SimPerception, ClothOccluder) {
 // The case slides 0.2 m and turns 20 degrees into a static hand, seen from
 // a camera that stays where it started. The part sliding behind the hand
 // stays remembered, moved with the motion estimated from the visible part
-// (follow_motion); C is within 1.7 cm of the whole case's centroid (about
-// 7.6 mm of it the half thickness the camera never sees; 1.85 cm when the
-// hidden part was left behind), and the visible part's own C is checked on
-// the frames with nothing hidden.
+// (follow_motion): C is within 1.5 cm of the whole case's centroid (13.3 mm
+// measured, 7.6 mm of it the half thickness the camera never sees; 18.5 mm
+// when the hidden part was left behind), and the visible part's own C is
+// checked on the frames with nothing hidden.
 TEST(SimPerception, MovingObject) {
   const EpisodeStats s = run_scenario("moving-object", 5.0);
   expect_quality(s, /*whole_object_centroid=*/false);
-  EXPECT_LE(s.worst_centroid_error, 0.017);
+  EXPECT_LE(s.worst_centroid_error, 0.015);
   EXPECT_GT(s.frames_with_occluder_in_sphere, 0);
 }
 

@@ -68,28 +68,29 @@ struct TrackingSettings {
   /// The object is lost when fewer of its voxels than this fraction of the
   /// previous frame's are found (the last known state is kept for re-acquisition).
   double min_kept_fraction = 0.2;
-  /// Object voxels hidden behind something nearer the camera are remembered
-  /// for this many frames, so the occluded part is recognised when it
-  /// reappears [frames].
+  /// Object voxels not seen in a frame (behind something nearer the camera,
+  /// out of the image, or on a pixel with no depth where the frame does not
+  /// show the same voxel through other pixels: a sensor's shadow beside an
+  /// occluder) are remembered for this many frames, so the occluded part is
+  /// recognised when it reappears and stays part of the object [frames].
   int occlusion_memory_frames = 60;
-  /// The object's supervoxels hidden behind something nearer the camera
-  /// (remembered as above) stay vertices of the estimator's problem, so the
+  /// The remembered hidden voxels, grouped per cell of the seed resolution
+  /// and per facing of their supervoxel's normal (as the seen part's
+  /// supervoxels are), are vertices of the estimator's problem too, so the
   /// view keeps the whole object clear, not only the part still seen.
   /// false: only the supervoxels seen in the frame (the paper's reading).
   bool hidden_vertices = true;
-  /// The remembered hidden voxels and vertices follow the object's rigid
-  /// motion between consecutive frames, estimated from its visible part: a
-  /// few Gauss-Newton (ICP) steps that align the frame's object voxels with
-  /// the previous frame's, point-to-plane on the surface and, at the
-  /// object's own outline (not where an occluder or the image border cuts
-  /// it), along the outline's normal. So the part hidden behind a static
-  /// occluder stays where the moving object is. Motion along a direction the
-  /// visible part does not constrain (a plain face sliding in its plane with
-  /// no outline seen) is taken as zero, and an estimate beyond max_motion or
-  /// from too little of the object is dropped: a static object does not
-  /// drift. false (default): hidden parts stay where they were last seen.
-  /// Off by default: on the simulator's moving-object scenario it did not
-  /// raise the visible fraction (see docs/perception.md).
+  /// The remembered hidden voxels follow the object's rigid motion between
+  /// consecutive frames, estimated from its visible part: a few Gauss-Newton
+  /// (ICP) steps that align the frame's object voxels with the previous
+  /// frame's, point-to-plane on the surface and, at the object's own outline
+  /// (not where an occluder or the image border cuts it), along the
+  /// outline's normal. So the part hidden behind a static occluder stays
+  /// where the moving object is. Motion along a direction the visible part
+  /// does not constrain (a plain face sliding in its plane with no outline
+  /// seen) is taken as zero, and an estimate beyond max_motion or from too
+  /// little of the object is dropped. false: hidden parts stay where they
+  /// were last seen.
   bool follow_motion = true;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
@@ -181,7 +182,7 @@ struct PerceptionCounts {
   std::size_t occluders = 0;
   std::size_t object_voxels = 0;  ///< seen in this frame
   std::size_t hidden_voxels = 0;  ///< remembered behind occluders, added to the object cloud
-  std::size_t hidden_vertices = 0;  ///< remembered object supervoxels added to the problem (hidden_vertices)
+  std::size_t hidden_vertices = 0;  ///< vertices of the remembered hidden voxels added to the problem (hidden_vertices)
 };
 
 /// \brief Wall time of each stage [ms].
