@@ -54,7 +54,8 @@ enum class Anticipation {
  * of every confirmed track moving faster than `min_speed` are copied to
  * where the track's velocity takes them after horizon x k / samples,
  * k = 1..samples; the copies inside the sphere join the frame's occluders
- * and the estimator (unchanged, the spec's) runs on that problem. The view
+ * and the estimator (unchanged, the spec's) runs on that problem, from the
+ * view the frame's own estimate found (the spec's warm start). The view
  * so keeps clear of the occluders' path over the horizon, and the camera
  * leaves before the object is covered. When the predicted problem has no
  * free view, the loop falls back to the frame's own (reactive) estimate.
