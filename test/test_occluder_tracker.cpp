@@ -159,6 +159,31 @@ TEST(OccluderTracker, PredictionShiftsMovingTracksOnly) {
   EXPECT_EQ(predicted_occluders({still}, {0.2}, 0.05).cols(), 0);
 }
 
+TEST(OccluderTracker, StillOccludersAreTheConfirmedSlowTracksSeenThisFrame) {
+  OccluderTrack moving;
+  moving.confirmed = true;
+  moving.velocity << 0.5, 0, 0;
+  moving.points = block({0, 0, 0});
+  OccluderTrack still = moving;
+  still.velocity << 0.01, 0, 0;
+  still.points = block({0.3, 0, 0});
+  OccluderTrack unconfirmed = still;  // a new track: not known to stand still yet
+  unconfirmed.confirmed = false;
+  OccluderTrack missed = still;  // not seen this frame
+  missed.points.resize(3, 0);
+  EXPECT_TRUE(is_moving(moving, 0.05));
+  EXPECT_FALSE(is_still(moving, 0.05));
+  EXPECT_TRUE(is_still(still, 0.05));
+  EXPECT_FALSE(is_moving(still, 0.05));
+  EXPECT_FALSE(is_still(unconfirmed, 0.05) || is_moving(unconfirmed, 0.05));
+  EXPECT_FALSE(is_still(missed, 0.05) || is_moving(missed, 0.05));
+  const Eigen::Matrix3Xd points = still_occluders({moving, unconfirmed, still, missed}, 0.05);
+  ASSERT_EQ(points.cols(), still.points.cols());
+  EXPECT_EQ(points, still.points);
+  // The same track is still or moving by the threshold.
+  EXPECT_EQ(still_occluders({moving}, 1.0).cols(), moving.points.cols());
+}
+
 TEST(OccluderTracker, SettingsAndPeriodsAreValidated) {
   TrackerSettings s;
   s.link_distance = 0.0;

@@ -264,7 +264,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   constexpr double kAway = 0.01;  // [m]: the camera has moved from a view
   constexpr int kFrames = 2;      // a loss counts when it lasts this many frames (one frame is noise)
   constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
-  constexpr double kEvidence = 0.5;  // [s]
+  constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
   const double keep = 1.0 - s.retreat_drop;
   if (held_) {
     const bool there = (here - held_->position).norm() <= kAway;

@@ -6,9 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
-
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace ofv {

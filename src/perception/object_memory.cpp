@@ -249,10 +249,10 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
                                 const std::vector<char>& object) {
   // Old object voxels not seen in this frame (behind something nearer the
   // camera, out of the image, or on a pixel with no depth away from the seen
-  // surface) stay in the state
-  // for a while, so that the object's occluded part is recognised when it
-  // reappears and stays part of the object (classify()).
-  // They follow the object's motion, estimated from what is seen of it.
+  // surface) stay in the state for a while, so that the object's occluded
+  // part is recognised when it reappears and stays part of the object
+  // (classify()). They follow the object's motion, estimated from what is
+  // seen of it.
   const Eigen::Isometry3d motion = object_motion(frame, r, object);
   const Eigen::Isometry3f motion_f = motion.cast<float>();
   std::vector<Eigen::Vector3f> next;
