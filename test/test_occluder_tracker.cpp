@@ -143,15 +143,19 @@ TEST(OccluderTracker, TwoOccludersKeepTheirTracksAndALostOneIsDropped) {
   EXPECT_EQ(tracker.tracks()[0].id, 0);
 }
 
+// A track seen this frame: a block of points at `at`, moving at `vx` along x.
+OccluderTrack track(double vx, const Eigen::Vector3d& at, bool confirmed = true) {
+  OccluderTrack t;
+  t.confirmed = confirmed;
+  t.velocity << vx, 0, 0;
+  t.points = block(at);
+  return t;
+}
+
 TEST(OccluderTracker, PredictionShiftsMovingTracksOnly) {
-  OccluderTrack moving;
-  moving.confirmed = true;
-  moving.velocity << 0.5, 0, 0;
-  moving.points = block({0, 0, 0});
-  OccluderTrack still = moving;
-  still.velocity << 0.01, 0, 0;
-  OccluderTrack unconfirmed = moving;
-  unconfirmed.confirmed = false;
+  const OccluderTrack moving = track(0.5, {0, 0, 0});
+  const OccluderTrack still = track(0.01, {0, 0, 0});
+  const OccluderTrack unconfirmed = track(0.5, {0, 0, 0}, false);
   const Eigen::Matrix3Xd ahead = predicted_occluders({moving, still, unconfirmed}, {0.2, 0.4}, 0.05);
   ASSERT_EQ(ahead.cols(), 64);
   EXPECT_TRUE(ahead.leftCols(32).isApprox(moving.points.colwise() + Eigen::Vector3d(0.1, 0, 0)));
@@ -160,15 +164,9 @@ TEST(OccluderTracker, PredictionShiftsMovingTracksOnly) {
 }
 
 TEST(OccluderTracker, StillOccludersAreTheConfirmedSlowTracksSeenThisFrame) {
-  OccluderTrack moving;
-  moving.confirmed = true;
-  moving.velocity << 0.5, 0, 0;
-  moving.points = block({0, 0, 0});
-  OccluderTrack still = moving;
-  still.velocity << 0.01, 0, 0;
-  still.points = block({0.3, 0, 0});
-  OccluderTrack unconfirmed = still;  // a new track: not known to stand still yet
-  unconfirmed.confirmed = false;
+  const OccluderTrack moving = track(0.5, {0, 0, 0});
+  const OccluderTrack still = track(0.01, {0.3, 0, 0});
+  const OccluderTrack unconfirmed = track(0.01, {0.3, 0, 0}, false);  // new: not known to stand still yet
   OccluderTrack missed = still;  // not seen this frame
   missed.points.resize(3, 0);
   EXPECT_TRUE(is_moving(moving, 0.05));
