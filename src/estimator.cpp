@@ -341,7 +341,8 @@ constexpr std::size_t kLanes = 8;
 // Buffers of freed PointRows kept for the next ones on the same thread: a
 // loop's frames would otherwise map, fault in and unmap the same megabytes
 // of fresh pages once per estimate (half the time of a frame's estimate with
-// ~10^5 occlusion points, measured in the closed loop). The two largest are kept.
+// ~10^5 occlusion points, measured in the closed loop). The two largest are
+// kept, up to kMaxKept doubles each: a one-off huge problem's memory is freed.
 class BufferCache {
  public:
   std::unique_ptr<double[]> take(std::size_t size, std::size_t& capacity) {
@@ -360,13 +361,14 @@ class BufferCache {
     for (Slot& s : slots_) {
       if (s.size < smallest->size) smallest = &s;
     }
-    if (size > smallest->size) {
+    if (size > smallest->size && size <= kMaxKept) {
       smallest->buffer = std::move(buffer);
       smallest->size = size;
     }
   }
 
  private:
+  static constexpr std::size_t kMaxKept = 3 * 3'000'000;  // 3·10^6 points, 72 MB
   struct Slot {
     std::unique_ptr<double[]> buffer;
     std::size_t size = 0;
