@@ -321,7 +321,13 @@ InitialViewChoice initial_view(const NormalRays& rays, const ObjectFrame& object
 // every product and sum on its own, as baseline x86-64 does (an FMA would give
 // other bits on AVX-512 machines than on the others). Together with the fixed
 // summation order of §4 below, every machine computes the same bits.
+// OFV_NO_AVX512_KERNELS (CMake option OFV_AVX512_KERNELS=OFF) drops the
+// AVX-512 clone: an AVX-512 machine then runs what an AVX2-only one runs.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__) && defined(OFV_NO_AVX512_KERNELS)
+#define OFV_POINT_KERNEL \
+  __attribute__((target_clones("avx2", "default"), optimize("fp-contract=off")))
+#elif defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
     !defined(__SANITIZE_ADDRESS__)
 #define OFV_POINT_KERNEL \
   __attribute__((target_clones("avx512f", "avx2", "default"), optimize("fp-contract=off")))
