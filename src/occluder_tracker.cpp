@@ -3,10 +3,13 @@
 
 #include "ofv/settings_table.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -111,6 +114,107 @@ std::optional<Eigen::Vector3d> register_translation(const Eigen::Matrix3Xd& befo
     if (step.norm() < 1e-5) break;
   }
   return d;
+}
+
+// Clusters that join occluders followed apart until now (a hand reaching the
+// table, two hands touching) are cut back into them, each part then owned by
+// its track. Each point of such a cluster goes to the track of the nearest
+// point of the tracks' predictions (the points seen last frame moved by the
+// track's velocity); a track claims a cluster when at least kMinClaim of
+// the cluster's points lie within `link` of its prediction, and a cluster
+// claimed by two tracks or more is cut between those. `owner[k]`: the track
+// of cluster k when it came from such a cut, else -1.
+constexpr int kMinClaim = 3;
+
+void split_merged(const std::vector<OccluderTrack>& tracks, double period, double link,
+                  std::vector<std::vector<int>>& clusters, const Eigen::Matrix3Xd& points,
+                  std::vector<int>& owner) {
+  owner.assign(clusters.size(), -1);
+  Eigen::Index total = 0;
+  int seen = 0;
+  for (const OccluderTrack& t : tracks) {
+    total += t.points.cols();
+    seen += t.points.cols() > 0 ? 1 : 0;
+  }
+  if (seen < 2) return;
+  Eigen::Matrix3Xd predicted(3, total);
+  std::vector<int> track_of(static_cast<std::size_t>(total));
+  std::vector<Eigen::AlignedBox3d> box(tracks.size());  // of each prediction, grown by link
+  Eigen::Index m = 0;
+  for (std::size_t t = 0; t < tracks.size(); ++t) {
+    const Eigen::Index n = tracks[t].points.cols();
+    predicted.middleCols(m, n) = tracks[t].points.colwise() + period * tracks[t].velocity;
+    std::fill_n(track_of.begin() + m, n, static_cast<int>(t));
+    if (n > 0) {
+      box[t] = Eigen::AlignedBox3d(predicted.middleCols(m, n).rowwise().minCoeff(),
+                                   predicted.middleCols(m, n).rowwise().maxCoeff());
+      box[t].extend(box[t].min() - Eigen::Vector3d::Constant(link)).extend(box[t].max() + Eigen::Vector3d::Constant(link));
+    }
+    m += n;
+  }
+  std::vector<Eigen::Index> by_x(static_cast<std::size_t>(total));
+  std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
+  std::sort(by_x.begin(), by_x.end(),
+            [&](Eigen::Index i, Eigen::Index j) { return predicted(0, i) < predicted(0, j); });
+  const double link2 = link * link;
+  const std::size_t n_clusters = clusters.size();
+  for (std::size_t c = 0; c < n_clusters; ++c) {
+    Eigen::AlignedBox3d extent;
+    for (const int i : clusters[c]) extent.extend(Eigen::Vector3d(points.col(i)));
+    if (std::count_if(box.begin(), box.end(), [&](const Eigen::AlignedBox3d& b) { return b.intersects(extent); }) < 2) {
+      continue;  // no two predictions come near it
+    }
+    std::vector<int> nearest_track;  // per point of the cluster
+    std::unordered_map<int, int> claims;
+    nearest_track.reserve(clusters[c].size());
+    for (const int i : clusters[c]) {
+      Eigen::Index nearest = 0;
+      const double d2 = nearest_by_x(predicted, by_x, points.col(i), nearest);
+      const int t = track_of[static_cast<std::size_t>(nearest)];
+      nearest_track.push_back(t);
+      if (d2 < link2) ++claims[t];
+    }
+    std::vector<int> claimants;
+    for (const auto& [t, n] : claims) {
+      if (n >= kMinClaim) claimants.push_back(t);
+    }
+    if (claimants.size() < 2) continue;
+    std::sort(claimants.begin(), claimants.end());
+    const auto claimant = [&](int t) {
+      const auto it = std::lower_bound(claimants.begin(), claimants.end(), t);
+      return it != claimants.end() && *it == t ? it - claimants.begin() : -1;
+    };
+    // A point whose nearest track does not claim the cluster goes to the
+    // nearest of the claimants' predicted points (searched in those alone).
+    std::vector<Eigen::Index> claimed_by_x;
+    std::vector<std::vector<int>> parts(claimants.size());
+    for (std::size_t k = 0; k < clusters[c].size(); ++k) {
+      const int i = clusters[c][k];
+      auto part = claimant(nearest_track[k]);
+      if (part < 0) {
+        if (claimed_by_x.empty()) {
+          std::copy_if(by_x.begin(), by_x.end(), std::back_inserter(claimed_by_x),
+                       [&](Eigen::Index j) { return claimant(track_of[static_cast<std::size_t>(j)]) >= 0; });
+        }
+        Eigen::Index nearest = 0;
+        nearest_by_x(predicted, claimed_by_x, points.col(i), nearest);
+        part = claimant(track_of[static_cast<std::size_t>(nearest)]);
+      }
+      parts[static_cast<std::size_t>(part)].push_back(i);
+    }
+    bool first = true;
+    for (std::size_t k = 0; k < claimants.size(); ++k) {
+      if (parts[k].empty()) continue;
+      if (first) {
+        clusters[c] = std::move(parts[k]);
+        owner[c] = claimants[k];
+        first = false;
+      } else {
+        clusters.push_back(std::move(parts[k]));
+        owner.push_back(claimants[k]);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -296,7 +400,9 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
   }
   started_ = true;
 
-  const std::vector<std::vector<int>> clusters = cluster_points(occluders, settings_.link_distance);
+  std::vector<std::vector<int>> clusters = cluster_points(occluders, settings_.link_distance);
+  std::vector<int> owner;
+  split_merged(tracks_, period, settings_.link_distance, clusters, occluders, owner);
   std::vector<Eigen::Vector3d> centroids;
   centroids.reserve(clusters.size());
   for (const auto& c : clusters) {
@@ -305,7 +411,15 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     centroids.emplace_back(sum / static_cast<double>(c.size()));
   }
 
-  // Greedy association, nearest pair first, within the gate.
+  // The parts of a cut cluster go to their tracks; then greedy association,
+  // nearest pair first, within the gate.
+  std::vector<int> cluster_of(tracks_.size(), -1);
+  std::vector<char> used(centroids.size(), 0);
+  for (std::size_t c = 0; c < owner.size(); ++c) {
+    if (owner[c] < 0) continue;
+    cluster_of[static_cast<std::size_t>(owner[c])] = static_cast<int>(c);
+    used[c] = 1;
+  }
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
   for (std::size_t t = 0; t < tracks_.size(); ++t) {
     const double gate = settings_.gate;
@@ -315,8 +429,6 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     }
   }
   std::sort(pairs.begin(), pairs.end());
-  std::vector<int> cluster_of(tracks_.size(), -1);
-  std::vector<char> used(centroids.size(), 0);
   for (const auto& [d, t, c] : pairs) {
     if (cluster_of[t] >= 0 || used[c]) continue;
     cluster_of[t] = static_cast<int>(c);

@@ -143,6 +143,29 @@ TEST(OccluderTracker, TwoOccludersKeepTheirTracksAndALostOneIsDropped) {
   EXPECT_EQ(tracker.tracks()[0].id, 0);
 }
 
+TEST(OccluderTracker, AHandThatReachesTheTableKeepsItsTrackAndVelocity) {
+  // A hand slides at 0.6 m/s over a still table, 4 cm above it: from the
+  // 12th frame on, single linkage joins them into one cluster. The cluster
+  // is cut back between the two tracks: the hand keeps its id and velocity,
+  // the table stays still (one cluster would move at neither speed).
+  Eigen::Matrix3Xd table(3, 21 * 21);
+  for (int k = 0; k < 21 * 21; ++k) table.col(k) = Eigen::Vector3d(-0.2 + 0.02 * (k % 21), 0.0, 0.2 + 0.02 * (k / 21));
+  const double dt = 1.0 / 30.0;
+  const double speed = 0.6;
+  OccluderTracker tracker;
+  for (int k = 0; k < 30; ++k) {
+    const auto& tracks = tracker.update(join(block({-0.5 + speed * k * dt, -0.1, 0.4}), table), dt);
+    ASSERT_EQ(tracks.size(), 2U) << "frame " << k;
+    EXPECT_EQ(tracks[0].points.cols(), 32) << "frame " << k;
+  }
+  const OccluderTrack& hand = tracker.tracks()[0];
+  const OccluderTrack& still = tracker.tracks()[1];
+  EXPECT_EQ(hand.id, 0);
+  EXPECT_LT((hand.velocity - Eigen::Vector3d(speed, 0, 0)).norm(), 0.03) << hand.velocity.transpose();
+  EXPECT_LT(still.velocity.norm(), 0.01) << still.velocity.transpose();
+  EXPECT_EQ(still.points.cols(), 21 * 21);
+}
+
 // A track seen this frame: a block of points at `at`, moving at `vx` along x.
 OccluderTrack track(double vx, const Eigen::Vector3d& at, bool confirmed = true) {
   OccluderTrack t;

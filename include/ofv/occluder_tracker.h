@@ -7,7 +7,12 @@
  * from the simulator's ground truth) are cut into clusters: single linkage,
  * two points in one cluster when a chain of points less than `link_distance`
  * apart joins them (a hand, an arm, a tool). Each cluster's centroid is a
- * measurement of one track.
+ * measurement of one track. A cluster that joins occluders followed apart
+ * until now (a hand reaching the table, two hands touching) is cut back
+ * into them: each of its points goes to the track whose prediction (last
+ * frame's points moved by the track's velocity) is nearest, when at least
+ * two tracks each have 3 of the cluster's points within `link_distance` of
+ * their prediction; each part is that track's measurement.
  *
  * A track is a constant-velocity Kalman filter on its position: state
  * (position, velocity), white-noise acceleration of spectral density
