@@ -3,6 +3,7 @@
 
 #include "ofv/settings_table.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -74,35 +75,49 @@ double nearest_by_x(const Eigen::Matrix3Xd& points, const std::vector<Eigen::Ind
   return best;
 }
 
-// Translation taking `before` onto the points `cluster` of `after`: a few
-// iterations of translation-only ICP from `guess`, each matching every point
+// A translation taking last frame's points onto this frame's, and how well
+// it fits: the fraction of the points tried that found a partner closer
+// than the trim, and the root mean square distance of those pairs.
+struct Registration {
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  double overlap = 0.0;
+  double rms = 0.0;
+};
+
+// Translation taking `before` onto `after`: a few iterations of
+// translation-only ICP from `guess`, each matching every point of `after`
 // (at most 256, evenly spread) with its nearest neighbour in the shifted
 // `before` and moving by the median residual (per axis) of the pairs closer
 // than `trim`. The median ignores the points that appear or vanish at the
 // edge of what is seen. None when fewer than half the points (or fewer than
 // 3) find a partner: the shapes do not overlap enough to register.
-std::optional<Eigen::Vector3d> register_translation(const Eigen::Matrix3Xd& before, const Eigen::Matrix3Xd& after,
-                                                    const std::vector<int>& cluster, const Eigen::Vector3d& guess,
-                                                    double trim) {
-  const std::size_t stride = std::max<std::size_t>(1, cluster.size() / 256);
+std::optional<Registration> register_translation(const Eigen::Matrix3Xd& before, const std::vector<Eigen::Index>& by_x,
+                                                 const Eigen::Matrix3Xd& after, const Eigen::Vector3d& guess,
+                                                 double trim) {
+  const auto n_after = static_cast<std::size_t>(after.cols());
+  const std::size_t stride = std::max<std::size_t>(1, n_after / 256);
   const double trim2 = trim * trim;
-  std::vector<Eigen::Index> by_x(static_cast<std::size_t>(before.cols()));
-  std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
-  std::sort(by_x.begin(), by_x.end(), [&](Eigen::Index i, Eigen::Index j) { return before(0, i) < before(0, j); });
   Eigen::Vector3d d = guess;
   std::array<std::vector<double>, 3> residuals;
-  for (int iteration = 0; iteration < 8; ++iteration) {
+  Registration result;
+  for (int iteration = 0; iteration < 9; ++iteration) {
     for (auto& r : residuals) r.clear();
     int tried = 0;
-    for (std::size_t k = 0; k < cluster.size(); k += stride, ++tried) {
-      const Eigen::Vector3d q = after.col(cluster[k]) - d;
+    double sum2 = 0.0;
+    for (std::size_t k = 0; k < n_after; k += stride, ++tried) {
+      const Eigen::Vector3d q = after.col(static_cast<Eigen::Index>(k)) - d;
       Eigen::Index nearest = 0;
       const double best = nearest_by_x(before, by_x, q, nearest);
       if (best >= trim2) continue;
+      sum2 += best;
       for (std::size_t a = 0; a < 3; ++a) residuals[a].push_back(q(static_cast<Eigen::Index>(a)) - before(static_cast<Eigen::Index>(a), nearest));
     }
     const auto pairs = static_cast<int>(residuals[0].size());
     if (pairs < 3 || 2 * pairs < tried) return std::nullopt;
+    result.shift = d;
+    result.overlap = static_cast<double>(pairs) / tried;
+    result.rms = std::sqrt(sum2 / pairs);
+    if (iteration == 8) break;  // the fit of the last step, measured
     Eigen::Vector3d step;
     for (std::size_t a = 0; a < 3; ++a) {
       auto& r = residuals[a];
@@ -111,9 +126,76 @@ std::optional<Eigen::Vector3d> register_translation(const Eigen::Matrix3Xd& befo
       step(static_cast<Eigen::Index>(a)) = *mid;
     }
     d += step;
-    if (step.norm() < 1e-5) break;
+    if (step.norm() < 1e-5) iteration = 7;  // converged: measure its fit
   }
-  return d;
+  return result;
+}
+
+// The translation of an occluder from last frame's points to this frame's,
+// registered from each of `starts`; of those that register, the best
+// overlap wins, then (within 5 % of overlap) the smallest rms distance,
+// then (within 20 % + 1 mm of it) the smallest motion. ICP keeps its start
+// along the directions a shape cannot tell (a capsule whose ends are not
+// seen, along its axis; a plane within itself; a grid by one spacing),
+// where every start fits as well: what cannot be seen to move is taken
+// as still (a stopped hand, a table, an arm growing into view would
+// otherwise keep the motion of the start). When too few of this frame's
+// points find last frame's (the part seen has grown: a table coming into
+// view), last frame's points are registered onto this frame's instead.
+std::optional<Eigen::Vector3d> track_motion(const Eigen::Matrix3Xd& before, const Eigen::Matrix3Xd& after,
+                                            const std::vector<Eigen::Vector3d>& starts, double trim) {
+  const auto sorted_by_x = [](const Eigen::Matrix3Xd& p) {
+    std::vector<Eigen::Index> by_x(static_cast<std::size_t>(p.cols()));
+    std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
+    std::sort(by_x.begin(), by_x.end(), [&](Eigen::Index i, Eigen::Index j) { return p(0, i) < p(0, j); });
+    return by_x;
+  };
+  const auto best_of = [&](const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, double sign)
+      -> std::optional<Eigen::Vector3d> {
+    const std::vector<Eigen::Index> by_x = sorted_by_x(from);
+    std::vector<Registration> found;
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      const bool repeated = std::any_of(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(k),
+                                        [&](const Eigen::Vector3d& s) { return (s - starts[k]).norm() < 0.005; });
+      if (repeated) continue;
+      if (auto r = register_translation(from, by_x, to, sign * starts[k], trim)) {
+        r->shift *= sign;
+        found.push_back(*r);
+      }
+    }
+    if (found.empty()) return std::nullopt;
+    double overlap = 0.0;
+    for (const auto& r : found) overlap = std::max(overlap, r.overlap);
+    double rms = std::numeric_limits<double>::infinity();
+    for (const auto& r : found) {
+      if (r.overlap >= overlap - 0.05) rms = std::min(rms, r.rms);
+    }
+    std::optional<Eigen::Vector3d> chosen;
+    for (const auto& r : found) {
+      if (r.overlap < overlap - 0.05 || r.rms > 1.2 * rms + 1e-3) continue;
+      if (!chosen || r.shift.norm() < chosen->norm()) chosen = r.shift;
+    }
+    return chosen;
+  };
+  if (auto forward = best_of(before, after, 1.0)) return forward;
+  return best_of(after, before, -1.0);
+}
+
+// The normal of a cluster that is a wide plane (a table): points spread
+// more than `width` (standard deviation) along two axes and less than a
+// tenth of that along the third. Such a plane's motion within itself cannot
+// be seen (the aperture problem): what changes is only which part of it is
+// seen (cut by the sphere, the image, the object's box), so only the motion
+// along its normal is measured.
+std::optional<Eigen::Vector3d> wide_plane_normal(const Eigen::Matrix3Xd& points, double width) {
+  if (points.cols() < 3) return std::nullopt;
+  const Eigen::Vector3d mean = points.rowwise().mean();
+  const Eigen::Matrix3Xd centred = points.colwise() - mean;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred * centred.transpose() /
+                                                          static_cast<double>(points.cols()));
+  const Eigen::Vector3d spread = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // increasing
+  if (!(spread(1) > width && spread(0) < 0.1 * spread(1))) return std::nullopt;
+  return Eigen::Vector3d(eig.eigenvectors().col(0));
 }
 
 // Clusters that join occluders followed apart until now (a hand reaching the
@@ -449,18 +531,35 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     // The measurement: where the points seen last frame have moved to
     // (registration), not the centroid, which also moves when the visible
     // part of an occluder changes (entering the sphere, the camera moving).
-    // Without a registration (a track missed last frame, or too little
-    // overlap), the centroid's offset from its prediction stands for the
-    // position's.
-    // The registration starts from the predicted motion, or, before the
-    // track has a velocity, from the centroid's: points about one spacing
-    // apart would otherwise register one spacing short (aliasing).
+    // The registration starts from the predicted motion, from none, and
+    // from the centroid's (before the track has a velocity, points about
+    // one spacing apart would otherwise register one spacing short:
+    // aliasing); see track_motion. A track missed last frame has no points:
+    // the centroid's offset from its prediction stands for the position's.
+    const Eigen::Matrix3Xd now = occluders(Eigen::all, clusters[c]);
     std::optional<Eigen::Vector3d> moved;
+    bool registered = true;
     if (track.points.cols() > 0) {
-      const Eigen::Vector3d guess =
-          track.hits >= 2 ? Eigen::Vector3d(period * track.velocity)
-                          : Eigen::Vector3d(centroids[c] - (track.centroid - period * track.velocity));
-      moved = register_translation(track.points, occluders, clusters[c], guess, settings_.link_distance);
+      const Eigen::Vector3d centroid_shift = centroids[c] - (track.centroid - period * track.velocity);
+      moved = track_motion(track.points, now, {period * track.velocity, Eigen::Vector3d::Zero(), centroid_shift},
+                           settings_.link_distance);
+      registered = moved.has_value();
+      if (moved) {
+        if (const auto normal = wide_plane_normal(now, 0.5 * settings_.link_distance)) moved = normal->dot(*moved) * *normal;
+      }
+    }
+    if (!registered) {
+      // The shapes do not overlap either way (the occluder turned, or the
+      // part seen changed whole): its motion is unknown, and the centroid's
+      // jump is none. The track starts again here, with its id.
+      track.position = track.centroid = centroids[c];
+      track.velocity.setZero();
+      track.covariance << r, 0.0, 0.0, settings_.initial_speed_sigma * settings_.initial_speed_sigma;
+      track.points = now;
+      track.hits = 1;
+      track.misses = 0;
+      kept.push_back(std::move(track));
+      continue;
     }
     const Eigen::Vector3d measured = moved ? Eigen::Vector3d(track.position - period * track.velocity + *moved)
                                            : Eigen::Vector3d(track.position + centroids[c] - track.centroid);
@@ -472,10 +571,7 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     const Eigen::Matrix2d i_kh = Eigen::Matrix2d::Identity() - gain * Eigen::RowVector2d(1.0, 0.0);
     track.covariance = i_kh * track.covariance;
     track.covariance = 0.5 * (track.covariance + track.covariance.transpose()).eval();
-    track.points.resize(3, static_cast<Eigen::Index>(clusters[c].size()));
-    for (std::size_t k = 0; k < clusters[c].size(); ++k) {
-      track.points.col(static_cast<Eigen::Index>(k)) = occluders.col(clusters[c][k]);
-    }
+    track.points = now;
     ++track.hits;
     track.misses = 0;
     track.confirmed = track.confirmed || track.hits >= settings_.confirm_hits;

@@ -166,6 +166,81 @@ TEST(OccluderTracker, AHandThatReachesTheTableKeepsItsTrackAndVelocity) {
   EXPECT_EQ(still.points.cols(), 21 * 21);
 }
 
+// A capsule's camera-facing half, axis along x, radius 3 cm, `length` long,
+// its centre at `centre`; points about 1.5 cm apart.
+Eigen::Matrix3Xd capsule_along_x(const Eigen::Vector3d& centre, double length) {
+  std::vector<Eigen::Vector3d> p;
+  const double radius = 0.03;
+  for (double x = -0.5 * length; x <= 0.5 * length + 1e-9; x += 0.015) {
+    for (int k = 0; k <= 6; ++k) {
+      const double a = EIGEN_PI * k / 6.0;  // the half facing -z
+      p.emplace_back(centre + Eigen::Vector3d(x, radius * std::cos(a), -radius * std::sin(a)));
+    }
+  }
+  Eigen::Matrix3Xd m(3, static_cast<Eigen::Index>(p.size()));
+  for (std::size_t k = 0; k < p.size(); ++k) m.col(static_cast<Eigen::Index>(k)) = p[k];
+  return m;
+}
+
+TEST(OccluderTracker, AHandThatStopsIsStillWithinAFewFrames) {
+  // A forearm (a 40 cm capsule, its ends outside the part seen: only its
+  // middle 20 cm) moves along its axis at 0.5 m/s, then stops. Along the
+  // axis its shape cannot tell motion: registration from the predicted
+  // motion alone kept the track moving for ever.
+  const double dt = 1.0 / 30.0;
+  const auto seen = [](const Eigen::Matrix3Xd& p) {  // the part between x = -0.1 and 0.1
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index k = 0; k < p.cols(); ++k) {
+      if (std::abs(p(0, k)) <= 0.1) keep.push_back(k);
+    }
+    return Eigen::Matrix3Xd(p(Eigen::all, keep));
+  };
+  OccluderTracker tracker;
+  double x = -0.2;
+  for (int k = 0; k < 15; ++k, x += 0.5 * dt) (void)tracker.update(seen(capsule_along_x({x, 0, 0.3}, 0.4)), dt);
+  for (int k = 0; k < 6; ++k) (void)tracker.update(seen(capsule_along_x({x, 0, 0.3}, 0.4)), dt);
+  ASSERT_EQ(tracker.tracks().size(), 1U);
+  EXPECT_LT(tracker.tracks()[0].velocity.norm(), 0.05) << tracker.tracks()[0].velocity.transpose();
+}
+
+TEST(OccluderTracker, AMovingCapsuleWhoseEndsAreSeenKeepsItsVelocity) {
+  const double dt = 1.0 / 30.0;
+  const Eigen::Vector3d v(0.6, 0.0, 0.0);  // along its axis
+  OccluderTracker tracker;
+  for (int k = 0; k < 15; ++k) (void)tracker.update(capsule_along_x(Eigen::Vector3d(-0.3, 0, 0.3) + k * dt * v, 0.1), dt);
+  ASSERT_EQ(tracker.tracks().size(), 1U);
+  EXPECT_LT((tracker.tracks()[0].velocity - v).norm(), 0.05) << tracker.tracks()[0].velocity.transpose();
+}
+
+TEST(OccluderTracker, ATableWhosePartInViewChangesStaysStill) {
+  // A still table top (y = 0.08) of which the part seen slides by 2 cm a
+  // frame (the camera turns): its motion within its plane cannot be seen,
+  // only along its normal; the track stays still.
+  const double dt = 1.0 / 30.0;
+  OccluderTracker tracker;
+  for (int f = 0; f < 12; ++f) {
+    Eigen::Matrix3Xd p(3, 10 * 10);
+    for (int k = 0; k < 100; ++k) p.col(k) = Eigen::Vector3d(-0.1 + 0.02 * (k % 10 + f), 0.08, 0.4 + 0.02 * (k / 10));
+    (void)tracker.update(p, dt);
+  }
+  ASSERT_EQ(tracker.tracks().size(), 1U);
+  EXPECT_LT(tracker.tracks()[0].velocity.norm(), 0.02) << tracker.tracks()[0].velocity.transpose();
+}
+
+TEST(OccluderTracker, ATableThatComesIntoViewStaysStill) {
+  // A still table top first seen as 3 points at a corner, then as a
+  // 12 cm square (it comes into view): most of the new points are far from
+  // the old ones (the old ones all find theirs, at no motion).
+  const double dt = 1.0 / 30.0;
+  Eigen::Matrix3Xd table(3, 49);
+  for (int k = 0; k < 49; ++k) table.col(k) = Eigen::Vector3d(0.02 * (k % 7), 0.08, 0.4 + 0.02 * (k / 7));
+  OccluderTracker tracker;
+  (void)tracker.update(table.leftCols(3), dt);
+  for (int f = 0; f < 3; ++f) (void)tracker.update(table, dt);
+  ASSERT_EQ(tracker.tracks().size(), 1U);
+  EXPECT_LT(tracker.tracks()[0].velocity.norm(), 0.05) << tracker.tracks()[0].velocity.transpose();
+}
+
 // A track seen this frame: a block of points at `at`, moving at `vx` along x.
 OccluderTrack track(double vx, const Eigen::Vector3d& at, bool confirmed = true) {
   OccluderTrack t;

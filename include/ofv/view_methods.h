@@ -106,7 +106,11 @@ struct NoFreeViewSettings {
   /// row (the scene changed). A target that only a partial perception
   /// believes clear (an occluder hidden behind another) so cannot lead the
   /// camera into a cage that hides the object, and occluders that move in
-  /// do not send it back into their way. 0 = off.
+  /// do not send it back into their way. On the way to a steady target
+  /// (the estimator converging within 10 deg of the previous frame's target
+  /// for 10 frames: a way around an occluder) only a loss of more than half
+  /// counts, and a hold that began before the target was steady ends when
+  /// it is. 0 = off.
   double retreat_drop = 0.1;
 };
 

@@ -184,7 +184,7 @@ SettingsTable<LoopSettings> make_table() {
   t.add({"retreat_drop", "number in [0, 1]", format_number(d.no_free_view.retreat_drop), "",
          "the fraction of the object the camera may see less, because it moved, than at the view that showed the "
          "most in the last 0.5 s, before it goes back there and holds (not when occluders moved in or came there "
-         "too), 0 (off) to 1"},
+         "too; on the way to a steady free view, only a loss of more than half), 0 (off) to 1"},
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
   t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
@@ -253,6 +253,9 @@ void ViewLoop::reset() {
   best_seen_.reset();
   held_.reset();
   low_frames_ = 0;
+  target_direction_.reset();
+  steady_frames_ = 0;
+  release_when_steady_ = false;
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, const ViewEstimate& estimate,
@@ -266,10 +269,35 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
   constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
   const double keep = 1.0 - s.retreat_drop;
+  // A steady free view: the estimator converges, frame after frame, to a
+  // target within kSteadyDeg of the previous frame's, for kSteadyFrames
+  // frames. A way around an occluder stays where it is, and the camera may
+  // lose some of the object on its way there (past the occluder's edge):
+  // unless it loses more than half of what it showed (kSteadyLoss), that
+  // is no reason to retreat. A hold that began while the target was not
+  // yet steady (an occluder arriving) ends when it is. Gaps that only
+  // perception's noise opens (an object in a cage of occluders) mostly
+  // move from frame to frame; a hold that began on the way to a steady
+  // target (it failed) is not ended by its steadiness.
+  constexpr double kSteadyDeg = 10.0;
+  constexpr int kSteadyFrames = 10;
+  constexpr double kSteadyLoss = 0.5;
+  if (target && estimate.status == ViewStatus::Converged) {
+    const Eigen::Vector3d direction = (*target - c).normalized();
+    const bool near = target_direction_ && direction.dot(*target_direction_) >= std::cos(kSteadyDeg * EIGEN_PI / 180.0);
+    steady_frames_ = near ? steady_frames_ + 1 : 1;
+    target_direction_ = direction;
+  } else {
+    steady_frames_ = 0;
+    target_direction_.reset();
+  }
+  const bool steady = steady_frames_ >= kSteadyFrames;
   if (held_) {
     const bool there = (here - held_->position).norm() <= kAway;
     low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
-    if (estimate.iterations > 0 && low_frames_ < kReleaseFrames) return held_->position;
+    if (estimate.iterations > 0 && low_frames_ < kReleaseFrames && !(steady && release_when_steady_)) {
+      return held_->position;
+    }
     held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
     best_seen_ = SeenView{here, shown, problem.occluders};
     low_frames_ = 0;
@@ -284,7 +312,8 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
     return target;
   }
   const bool away = (here - best_seen_->position).norm() > kAway;
-  low_frames_ = away && shown < keep * best_seen_->shown ? low_frames_ + 1 : 0;
+  const bool lost = shown < keep * best_seen_->shown && (!steady || shown < kSteadyLoss * best_seen_->shown);
+  low_frames_ = away && lost ? low_frames_ + 1 : 0;
   if (low_frames_ < kFrames) return target;
   const double r = estimator_.r_sphere;
   const auto score = [&](const ViewProblem& scene, const Eigen::Vector3d& p) {
@@ -306,6 +335,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   const double margin = here_score < 0.5 ? 0.0 : 0.1;
   if (score(problem, best_seen_->position) < here_score + margin) return target;  // the occluders came there too
   held_ = best_seen_;
+  release_when_steady_ = !steady;
   low_frames_ = 0;
   return held_->position;
 }

@@ -176,6 +176,9 @@ class ViewLoop {
   std::optional<SeenView> best_seen_;  ///< the view that showed the most of the object
   std::optional<SeenView> held_;       ///< retreated there: hold
   int low_frames_ = 0;                 ///< frames in a row showing much less than best_seen_ or held_
+  std::optional<Eigen::Vector3d> target_direction_;  ///< last converged target, unit vector from C
+  int steady_frames_ = 0;              ///< frames in a row it stayed near the previous one
+  bool release_when_steady_ = false;   ///< the hold began on the way to a target not yet steady
 };
 
 }  // namespace ofv
