@@ -51,10 +51,11 @@ void require(bool ok, const char* name, double value, const char* what) {
 // Nearest of `points` to `q`: the smallest index of those at the least
 // squared distance, as a scan of every point finds it, from a search that
 // looks only at the points whose x is within that distance (`by_x`: the
-// indices of `points` sorted by x). Returns the squared distance.
+// indices of `points` sorted by x). Returns the squared distance, or
+// `within2` when no point is closer than that (then `nearest` is 0).
 double nearest_by_x(const Eigen::Matrix3Xd& points, const std::vector<Eigen::Index>& by_x, const Eigen::Vector3d& q,
-                    Eigen::Index& nearest) {
-  double best = std::numeric_limits<double>::infinity();
+                    Eigen::Index& nearest, double within2 = std::numeric_limits<double>::infinity()) {
+  double best = within2;
   nearest = 0;
   const auto first_right = std::lower_bound(by_x.begin(), by_x.end(), q.x(),
                                             [&](Eigen::Index i, double x) { return points(0, i) < x; });
@@ -86,16 +87,16 @@ struct Registration {
 
 // Translation taking `before` onto `after`: a few iterations of
 // translation-only ICP from `guess`, each matching every point of `after`
-// (at most 256, evenly spread) with its nearest neighbour in the shifted
+// (at most `max_points`, evenly spread) with its nearest neighbour in the shifted
 // `before` and moving by the median residual (per axis) of the pairs closer
 // than `trim`. The median ignores the points that appear or vanish at the
 // edge of what is seen. None when fewer than half the points (or fewer than
 // 3) find a partner: the shapes do not overlap enough to register.
 std::optional<Registration> register_translation(const Eigen::Matrix3Xd& before, const std::vector<Eigen::Index>& by_x,
                                                  const Eigen::Matrix3Xd& after, const Eigen::Vector3d& guess,
-                                                 double trim) {
+                                                 double trim, std::size_t max_points) {
   const auto n_after = static_cast<std::size_t>(after.cols());
-  const std::size_t stride = std::max<std::size_t>(1, n_after / 256);
+  const std::size_t stride = std::max<std::size_t>(1, n_after / max_points);
   const double trim2 = trim * trim;
   Eigen::Vector3d d = guess;
   std::array<std::vector<double>, 3> residuals;
@@ -107,7 +108,7 @@ std::optional<Registration> register_translation(const Eigen::Matrix3Xd& before,
     for (std::size_t k = 0; k < n_after; k += stride, ++tried) {
       const Eigen::Vector3d q = after.col(static_cast<Eigen::Index>(k)) - d;
       Eigen::Index nearest = 0;
-      const double best = nearest_by_x(before, by_x, q, nearest);
+      const double best = nearest_by_x(before, by_x, q, nearest, trim2);
       if (best >= trim2) continue;
       sum2 += best;
       for (std::size_t a = 0; a < 3; ++a) residuals[a].push_back(q(static_cast<Eigen::Index>(a)) - before(static_cast<Eigen::Index>(a), nearest));
@@ -150,6 +151,8 @@ std::optional<Eigen::Vector3d> track_motion(const Eigen::Matrix3Xd& before, cons
     std::sort(by_x.begin(), by_x.end(), [&](Eigen::Index i, Eigen::Index j) { return p(0, i) < p(0, j); });
     return by_x;
   };
+  constexpr std::size_t kChoosePoints = 64;   // points tried from every start
+  constexpr std::size_t kRefinePoints = 256;  // from the chosen one
   const auto best_of = [&](const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, double sign)
       -> std::optional<Eigen::Vector3d> {
     const std::vector<Eigen::Index> by_x = sorted_by_x(from);
@@ -158,10 +161,7 @@ std::optional<Eigen::Vector3d> track_motion(const Eigen::Matrix3Xd& before, cons
       const bool repeated = std::any_of(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(k),
                                         [&](const Eigen::Vector3d& s) { return (s - starts[k]).norm() < 0.005; });
       if (repeated) continue;
-      if (auto r = register_translation(from, by_x, to, sign * starts[k], trim)) {
-        r->shift *= sign;
-        found.push_back(*r);
-      }
+      if (auto r = register_translation(from, by_x, to, sign * starts[k], trim, kChoosePoints)) found.push_back(*r);
     }
     if (found.empty()) return std::nullopt;
     double overlap = 0.0;
@@ -175,7 +175,10 @@ std::optional<Eigen::Vector3d> track_motion(const Eigen::Matrix3Xd& before, cons
       if (r.overlap < overlap - 0.05 || r.rms > 1.2 * rms + 1e-3) continue;
       if (!chosen || r.shift.norm() < chosen->norm()) chosen = r.shift;
     }
-    return chosen;
+    if (!chosen) return std::nullopt;
+    // Refined from the chosen start with more points.
+    const auto refined = register_translation(from, by_x, to, *chosen, trim, kRefinePoints);
+    return sign * (refined ? refined->shift : *chosen);
   };
   if (auto forward = best_of(before, after, 1.0)) return forward;
   return best_of(after, before, -1.0);
@@ -540,13 +543,15 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     std::optional<Eigen::Vector3d> moved;
     bool registered = true;
     if (track.points.cols() > 0) {
+      // A wide plane registers from no motion alone: only the motion along
+      // its normal counts.
       const Eigen::Vector3d centroid_shift = centroids[c] - (track.centroid - period * track.velocity);
-      moved = track_motion(track.points, now, {period * track.velocity, Eigen::Vector3d::Zero(), centroid_shift},
-                           settings_.link_distance);
+      const auto normal = wide_plane_normal(now, 0.5 * settings_.link_distance);
+      std::vector<Eigen::Vector3d> starts{Eigen::Vector3d::Zero()};
+      if (!normal) starts.insert(starts.end(), {period * track.velocity, centroid_shift});
+      moved = track_motion(track.points, now, starts, settings_.link_distance);
       registered = moved.has_value();
-      if (moved) {
-        if (const auto normal = wide_plane_normal(now, 0.5 * settings_.link_distance)) moved = normal->dot(*moved) * *normal;
-      }
+      if (moved && normal) moved = normal->dot(*moved) * *normal;
     }
     if (!registered) {
       // The shapes do not overlap either way (the occluder turned, or the
