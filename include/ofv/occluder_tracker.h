@@ -20,12 +20,20 @@
  * Applications to Tracking and Navigation", 6.2.2), position measurements
  * with standard deviation `measurement_noise`. The position measured is
  * the previous position moved by the translation that registers the
- * track's previous points onto the cluster's (translation-only ICP from the
- * predicted motion), not the cluster's centroid: the centroid also moves
- * when the visible part of an occluder changes (an arm entering the sphere,
- * the camera moving along a table), the registered points do not. The three axes are
- * independent with the same noises, so one 2 x 2 covariance (position,
- * velocity of one axis) holds for all three.
+ * track's previous points onto the cluster's, not the cluster's centroid:
+ * the centroid also moves when the visible part of an occluder changes (an
+ * arm entering the sphere, the camera moving along a table), the
+ * registered points do not. The registration (translation-only ICP) starts
+ * from the predicted motion, from none and from the centroid's motion; the
+ * best fit wins, and among fits equally good the smallest motion: what the
+ * shape cannot show moving (a capsule along its axis, ends unseen) is taken
+ * as still. A wide plane (a table) is measured along its normal only (the
+ * aperture problem). When too few of the cluster's points find the
+ * previous ones (the part seen grew), the previous points are registered
+ * onto the cluster's; when neither registers, the track starts again where
+ * the cluster is, with its id. The three axes are independent with the same
+ * noises, so one 2 x 2 covariance (position, velocity of one axis) holds
+ * for all three.
  *
  * Association: every track's last centroid is moved by its velocity to
  * the frame's time; cluster and track pairs whose centroids are closer than
