@@ -76,6 +76,14 @@ double nearest_by_x(const Eigen::Matrix3Xd& points, const std::vector<Eigen::Ind
   return best;
 }
 
+// The column indices of `points` sorted by x, for nearest_by_x.
+std::vector<Eigen::Index> indices_by_x(const Eigen::Matrix3Xd& points) {
+  std::vector<Eigen::Index> by_x(static_cast<std::size_t>(points.cols()));
+  std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
+  std::sort(by_x.begin(), by_x.end(), [&](Eigen::Index i, Eigen::Index j) { return points(0, i) < points(0, j); });
+  return by_x;
+}
+
 // A translation taking last frame's points onto this frame's, and how well
 // it fits: the fraction of the points tried that found a partner closer
 // than the trim, and the root mean square distance of those pairs.
@@ -145,17 +153,11 @@ std::optional<Registration> register_translation(const Eigen::Matrix3Xd& before,
 // view), last frame's points are registered onto this frame's instead.
 std::optional<Eigen::Vector3d> track_motion(const Eigen::Matrix3Xd& before, const Eigen::Matrix3Xd& after,
                                             const std::vector<Eigen::Vector3d>& starts, double trim) {
-  const auto sorted_by_x = [](const Eigen::Matrix3Xd& p) {
-    std::vector<Eigen::Index> by_x(static_cast<std::size_t>(p.cols()));
-    std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
-    std::sort(by_x.begin(), by_x.end(), [&](Eigen::Index i, Eigen::Index j) { return p(0, i) < p(0, j); });
-    return by_x;
-  };
   constexpr std::size_t kChoosePoints = 64;   // points tried from every start
   constexpr std::size_t kRefinePoints = 256;  // from the chosen one
   const auto best_of = [&](const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, double sign)
       -> std::optional<Eigen::Vector3d> {
-    const std::vector<Eigen::Index> by_x = sorted_by_x(from);
+    const std::vector<Eigen::Index> by_x = indices_by_x(from);
     std::vector<Registration> found;
     for (std::size_t k = 0; k < starts.size(); ++k) {
       const bool repeated = std::any_of(starts.begin(), starts.begin() + static_cast<std::ptrdiff_t>(k),
@@ -237,10 +239,7 @@ void split_merged(const std::vector<OccluderTrack>& tracks, double period, doubl
     }
     m += n;
   }
-  std::vector<Eigen::Index> by_x(static_cast<std::size_t>(total));
-  std::iota(by_x.begin(), by_x.end(), Eigen::Index{0});
-  std::sort(by_x.begin(), by_x.end(),
-            [&](Eigen::Index i, Eigen::Index j) { return predicted(0, i) < predicted(0, j); });
+  const std::vector<Eigen::Index> by_x = indices_by_x(predicted);
   const double link2 = link * link;
   const std::size_t n_clusters = clusters.size();
   for (std::size_t c = 0; c < n_clusters; ++c) {
@@ -588,10 +587,7 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     track.id = next_id_++;
     track.position = track.centroid = centroids[c];
     track.covariance << r, 0.0, 0.0, settings_.initial_speed_sigma * settings_.initial_speed_sigma;
-    track.points.resize(3, static_cast<Eigen::Index>(clusters[c].size()));
-    for (std::size_t k = 0; k < clusters[c].size(); ++k) {
-      track.points.col(static_cast<Eigen::Index>(k)) = occluders.col(clusters[c][k]);
-    }
+    track.points = occluders(Eigen::all, clusters[c]);
     track.hits = 1;
     track.confirmed = settings_.confirm_hits <= 1;
     kept.push_back(std::move(track));
