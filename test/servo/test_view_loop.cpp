@@ -126,8 +126,9 @@ enum class Loss {
   Follows,   // a cluster that moves with the camera, between it and the patch
 };
 
-// Three frames on the way to the estimator's view; returns the last target.
-Eigen::Vector3d after_leaving(double retreat_drop, Loss loss) {
+// `settle` frames at the origin, then three on the way to the estimator's
+// view showing `shown_on_way` (of 100 at the origin); returns the last target.
+Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, double shown_on_way = 50.0) {
   LoopSettings settings;
   settings.no_free_view.retreat_drop = retreat_drop;
   ViewLoop loop(settings);
@@ -135,7 +136,8 @@ Eigen::Vector3d after_leaving(double retreat_drop, Loss loss) {
   ViewProblem start = patch(false);
   start.occluders.resize(3, 9);
   for (int k = 0; k < 9; ++k) start.occluders.col(k) << (k % 3 - 1) * 0.01 + 0.02, (k / 3 - 1) * 0.01 + 0.02, 0.3;
-  LoopStep s = loop.step(start, vpHomogeneousMatrix(), dt, 0.0, /*shown=*/100.0);
+  LoopStep s;
+  for (int k = 0; k < settle; ++k) s = loop.step(start, vpHomogeneousMatrix(), dt, 0.0, /*shown=*/100.0);
   EXPECT_TRUE(s.target);
   const Eigen::Vector3d away = *s.target;
   EXPECT_GT(away.norm(), 0.05);
@@ -150,7 +152,7 @@ Eigen::Vector3d after_leaving(double retreat_drop, Loss loss) {
     p.occluders.conservativeResize(3, 9 + 49);
     for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = cluster + spacing * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
     s = loop.step(p, vpHomogeneousMatrix(vpTranslationVector(camera.x(), camera.y(), camera.z()), vpRotationMatrix()),
-                  dt, 0.0, /*shown=*/50.0);
+                  dt, 0.0, shown_on_way);
     EXPECT_TRUE(s.target);
   }
   return s.target.value_or(Eigen::Vector3d::Constant(NAN));
@@ -168,6 +170,16 @@ TEST(ViewLoop, RetreatsWhenItsOwnMotionHidesTheObject) {
   EXPECT_GT(after_leaving(0.0, Loss::Revealed).norm(), 0.05);
   EXPECT_GT(after_leaving(0.2, Loss::CameTo).norm(), 0.05);
   EXPECT_GT(after_leaving(0.2, Loss::Follows).norm(), 0.05);
+}
+
+TEST(ViewLoop, OnTheWayToASteadyFreeViewOnlyLosingMoreThanHalfRetreats) {
+  // The estimator has converged to the same view for 12 frames (a way
+  // around an occluder): losing 40 % on the way there is no reason to go
+  // back, losing 60 % still is.
+  EXPECT_GT(after_leaving(0.2, Loss::Revealed, 12, 60.0).norm(), 0.05);
+  EXPECT_LT(after_leaving(0.2, Loss::Revealed, 12, 40.0).norm(), 1e-12);
+  // Without the steady frames, 40 % is enough.
+  EXPECT_LT(after_leaving(0.2, Loss::Revealed, 1, 60.0).norm(), 1e-12);
 }
 
 TEST(ViewLoop, SettingsByNameAreValidated) {
