@@ -323,14 +323,15 @@ InitialViewChoice initial_view(const NormalRays& rays, const ObjectFrame& object
 // summation order of §4 below, every machine computes the same bits.
 // OFV_NO_AVX512_KERNELS (CMake option OFV_AVX512_KERNELS=OFF) drops the
 // AVX-512 clone: an AVX-512 machine then runs what an AVX2-only one runs.
+#if defined(OFV_NO_AVX512_KERNELS)
+#define OFV_KERNEL_TARGETS "avx2", "default"
+#else
+#define OFV_KERNEL_TARGETS "avx512f", "avx2", "default"
+#endif
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__) && defined(OFV_NO_AVX512_KERNELS)
-#define OFV_POINT_KERNEL \
-  __attribute__((target_clones("avx2", "default"), optimize("fp-contract=off")))
-#elif defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
     !defined(__SANITIZE_ADDRESS__)
 #define OFV_POINT_KERNEL \
-  __attribute__((target_clones("avx512f", "avx2", "default"), optimize("fp-contract=off")))
+  __attribute__((target_clones(OFV_KERNEL_TARGETS), optimize("fp-contract=off")))
 #elif defined(__GNUC__) && !defined(__clang__)
 #define OFV_POINT_KERNEL __attribute__((optimize("fp-contract=off")))
 #else
