@@ -3,6 +3,7 @@
 // initial view (§2), occlusion-to-sphere rays (§3), the iteration (§4) and the
 // angular errors (§6). estimate_view() at the bottom reads as that sequence.
 #include "estimator_errors.h"
+#include "point_kernel.h"
 #include "ofv/constants.h"
 #include "ofv/estimator.h"
 
@@ -13,6 +14,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -316,34 +319,14 @@ InitialViewChoice initial_view(const NormalRays& rays, const ObjectFrame& object
 // ---------------------------------------------------------------------------
 // §3: occlusion-to-sphere rays.
 
-// The point kernels below are compiled for AVX-512, AVX2 and baseline x86-64,
-// picked at run time, with floating-point contraction off: every clone rounds
-// every product and sum on its own, as baseline x86-64 does (an FMA would give
-// other bits on AVX-512 machines than on the others). Together with the fixed
-// summation order of §4 below, every machine computes the same bits.
-// OFV_NO_AVX512_KERNELS (CMake option OFV_AVX512_KERNELS=OFF) drops the
-// AVX-512 clone: an AVX-512 machine then runs what an AVX2-only one runs.
-#if defined(OFV_NO_AVX512_KERNELS)
-#define OFV_KERNEL_TARGETS "avx2", "default"
-#else
-#define OFV_KERNEL_TARGETS "avx512f", "avx2", "default"
-#endif
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define OFV_POINT_KERNEL \
-  __attribute__((target_clones(OFV_KERNEL_TARGETS), optimize("fp-contract=off")))
-#elif defined(__GNUC__) && !defined(__clang__)
-#define OFV_POINT_KERNEL __attribute__((optimize("fp-contract=off")))
-#else
-#define OFV_POINT_KERNEL
-#endif
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#endif
+// The point kernels (point_kernel.h) round every operation on its own.
 
 // §4 sums the projected points in kLanes interleaved partial sums (see
 // sum_projection); storage is padded to whole rows of kLanes points.
 constexpr std::size_t kLanes = 8;
+
+// The largest buffers a thread keeps for reuse: 3·10^6 points, 72 MB.
+constexpr std::size_t kMaxKeptPoints = 3'000'000;
 
 // Buffers of freed PointRows kept for the next ones on the same thread: a
 // loop's frames would otherwise map, fault in and unmap the same megabytes
@@ -352,16 +335,32 @@ constexpr std::size_t kLanes = 8;
 // kept, up to kMaxKept doubles each: a one-off huge problem's memory is freed.
 class BufferCache {
  public:
+  // The smallest kept buffer of at least `size` doubles, else a new one.
   std::unique_ptr<double[]> take(std::size_t size, std::size_t& capacity) {
+    Slot* fit = nullptr;
     for (Slot& s : slots_) {
-      if (s.buffer && s.size >= size) {
-        capacity = s.size;
-        s.size = 0;
-        return std::move(s.buffer);
-      }
+      if (s.buffer && s.size >= size && (!fit || s.size < fit->size)) fit = &s;
+    }
+    if (fit) {
+      capacity = fit->size;
+      fit->size = 0;
+      return std::move(fit->buffer);
     }
     capacity = size + size / 2;  // room to grow: fewer fresh buffers while problems grow
     return std::unique_ptr<double[]>(new double[capacity]);
+  }
+  // Makes sure the two slots hold buffers of at least `size` doubles,
+  // written once so that their pages are mapped. A thread's high-water
+  // mark: asking again for as much or less does nothing.
+  void reserve(std::size_t size) {
+    if (size <= reserved_) return;
+    reserved_ = std::min(size, kMaxKept);
+    for (Slot& s : slots_) {
+      if (s.size >= reserved_) continue;
+      s.buffer.reset(new double[reserved_]);
+      std::fill(s.buffer.get(), s.buffer.get() + reserved_, 0.0);
+      s.size = reserved_;
+    }
   }
   void give(std::unique_ptr<double[]> buffer, std::size_t size) {
     Slot* smallest = &slots_[0];
@@ -375,12 +374,13 @@ class BufferCache {
   }
 
  private:
-  static constexpr std::size_t kMaxKept = 3 * 3'000'000;  // 3·10^6 points, 72 MB
+  static constexpr std::size_t kMaxKept = 3 * kMaxKeptPoints;
   struct Slot {
     std::unique_ptr<double[]> buffer;
     std::size_t size = 0;
   };
   Slot slots_[2];
+  std::size_t reserved_ = 0;
 };
 
 BufferCache& buffer_cache() {
@@ -647,26 +647,28 @@ Projection project(const PointRows& pts, const Eigen::Vector3d& t_from_c, double
   return p;
 }
 
-// How many of the n points are closer than sqrt(keep2) to t.
-OFV_POINT_KERNEL std::size_t count_within(const double* x, const double* y, const double* z,
-                                        std::size_t n, double tx, double ty, double tz,
-                                        double keep2) {
+// Marks the n points closer than sqrt(keep2) to t (1, else 0); returns how many.
+OFV_POINT_KERNEL std::size_t mark_within(const double* x, const double* y, const double* z, std::size_t n,
+                                         double tx, double ty, double tz, double keep2, unsigned char* in) {
   std::size_t kept = 0;
 #pragma omp simd reduction(+ : kept)
   for (std::size_t k = 0; k < n; ++k) {
     const double ex = x[k] - tx, ey = y[k] - ty, ez = z[k] - tz;
-    kept += ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
+    const unsigned char near = ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
+    in[k] = near;
+    kept += near;
   }
   return kept;
 }
 
-// Pruning. A point d on the sphere at angle a from w projects at distance
-// R tan(a) from t, and its chord to t - C is 2 R sin(a/2) <= R tan(a) for a
-// in [0, 90 deg); beyond 90 deg it has no image. So a point whose chord to the
-// iterate is at least rho = max(clearance, push_radius) is neither counted in
-// the clearance disc nor in J: its terms are exact zeros. The margins
-// (relative 1e-9, absolute 1e-9 R) cover the rounding of the stored points
-// and iterates off the sphere (~1e-16 R) and of the computed distances.
+// Pruning. A point d on the sphere at angle a < 90 deg from w projects at
+// distance R tan(a) from t; beyond 90 deg it has no image. So a point is
+// counted in the clearance disc or in J only if tan(a) < rho / R, rho =
+// max(clearance, push_radius): only if its chord to t - C, 2 R sin(a/2), is
+// below reach = 2 R sin(atan(rho / R) / 2). The terms of the others are exact
+// zeros. The margins (relative 1e-9, absolute 1e-9 R) cover the rounding of
+// the stored points and iterates off the sphere (~1e-16 R) and of the
+// computed distances.
 //
 // The kept set is chosen at an iterate t_k with `slack` to spare, and stays
 // valid while the iterate is within `slack` of t_k (triangle inequality), so
@@ -677,8 +679,9 @@ class PrunedPoints {
   PrunedPoints(const OcclusionRays& all, const EstimatorSettings& s)
       : all_(all), r_(s.r_sphere) {
     const double rho = std::max(s.clearance, s.push_radius);
-    slack_ = std::max(4.0 * s.step, 0.25 * rho);
-    keep_radius_ = rho * (1.0 + 1e-9) + 1e-9 * r_ + slack_;
+    const double reach = 2.0 * r_ * std::sin(0.5 * std::atan(rho / r_));
+    slack_ = std::max(4.0 * s.step, 0.25 * reach);
+    keep_radius_ = reach * (1.0 + 1e-9) + 1e-9 * r_ + slack_;
     // Every chord is at most 2R: then nothing can ever be left out.
     never_ = keep_radius_ >= 2.0 * r_ * (1.0 - 1e-9) || all.points.rows < 4;
   }
@@ -703,23 +706,30 @@ class PrunedPoints {
     const double* y = a.y;
     const double* z = a.z;
     const double tx = t_from_c.x(), ty = t_from_c.y(), tz = t_from_c.z();
-    std::size_t n_keep = count_within(x, y, z, n, tx, ty, tz, keep2);
+    in_.resize(n);
+    const std::size_t n_keep = mark_within(x, y, z, n, tx, ty, tz, keep2, in_.data());
     use_all_ = n_keep * 2 > n;
     if (use_all_) return;
     // Each lane keeps its own points in order, so each partial sum of §4
-    // meets the same non-zero terms in the same order.
+    // meets the same non-zero terms in the same order. Row by row, in
+    // memory order; the kept points are near each other (one supervoxel's
+    // rays through one occluder cluster), so most rows keep none.
     std::size_t lane_rows[kLanes] = {};
     kept_.reserve_rows(a.rows);
-    for (std::size_t l = 0; l < kLanes; ++l) {
-      std::size_t m = 0;
-      for (std::size_t k = l; k < n; k += kLanes) {
-        const double ex = x[k] - tx, ey = y[k] - ty, ez = z[k] - tz;
-        kept_.x[m * kLanes + l] = x[k];
-        kept_.y[m * kLanes + l] = y[k];
-        kept_.z[m * kLanes + l] = z[k];
-        m += ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
+    for (std::size_t row = 0; row < a.rows; ++row) {
+      const unsigned char* in = in_.data() + row * kLanes;
+      static_assert(kLanes == sizeof(std::uint64_t), "a row's marks are read as one word");
+      std::uint64_t any = 0;
+      std::memcpy(&any, in, kLanes);
+      if (any == 0) continue;
+      for (std::size_t l = 0; l < kLanes; ++l) {
+        if (in[l] == 0) continue;
+        const std::size_t k = row * kLanes + l;
+        const std::size_t to = lane_rows[l]++ * kLanes + l;
+        kept_.x[to] = x[k];
+        kept_.y[to] = y[k];
+        kept_.z[to] = z[k];
       }
-      lane_rows[l] = m;
     }
     kept_.rows = *std::max_element(lane_rows, lane_rows + kLanes);
     for (std::size_t l = 0; l < kLanes; ++l) {  // pad with d = 0 (no image)
@@ -737,6 +747,7 @@ class PrunedPoints {
   bool valid_ = false;
   bool use_all_ = true;
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  std::vector<unsigned char> in_;  // the mark of each point at the last selection
   PointRows kept_;
 };
 
@@ -987,6 +998,11 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
     }
   }
   return est;
+}
+
+void reserve_estimator_memory(std::size_t occlusion_points) {
+  const std::size_t rows = (std::min(occlusion_points, kMaxKeptPoints) + kLanes - 1) / kLanes;
+  buffer_cache().reserve(3 * rows * kLanes);
 }
 
 UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere) {

@@ -1,11 +1,13 @@
 // View selection methods besides the estimator (baselines).
 #include "ofv/view_methods.h"
 #include "ofv/constants.h"
+#include "point_kernel.h"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 
 namespace ofv {
@@ -21,23 +23,48 @@ double mean_error_deg(const UsableInput& u, const Eigen::Vector3d& c, const Eige
   return u.rays.cols() > 0 ? error / static_cast<double>(u.rays.cols()) * kRadToDeg : 0.0;
 }
 
+// Whether one of the n occluders (o - p by coordinate) lies closer than
+// sqrt(rho2) to the segment from p to p + seg (len2 = |seg|^2): rel - t seg,
+// t = rel . seg / len2 clamped to [0, 1], computed as Eigen computes it for
+// one Vector3d (x + (y + z) for dot products).
+OFV_POINT_KERNEL bool any_near_segment(const double* x, const double* y, const double* z, std::size_t n,
+                                       double px, double py, double pz, double sx, double sy, double sz,
+                                       double len2, double rho2) {
+  int near = 0;
+#pragma omp simd reduction(| : near)
+  for (std::size_t b = 0; b < n; ++b) {
+    const double rx = x[b] - px, ry = y[b] - py, rz = z[b] - pz;
+    double t = (rx * sx + (ry * sy + rz * sz)) / len2;
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    const double dx = rx - t * sx, dy = ry - t * sy, dz = rz - t * sz;
+    near |= dx * dx + (dy * dy + dz * dz) < rho2 ? 1 : 0;
+  }
+  return near != 0;
+}
+
 ScoredView score(const UsableInput& u, const Eigen::Vector3d& c,
                  const Eigen::Vector3d& view, double rho) {
   ScoredView s;
   s.view = view;
   const Eigen::Index n = u.positions.cols();
   if (n == 0) return s;
+  // The occluders by coordinate, tested in blocks: a blocked line of sight
+  // stops at its first block with a hit.
+  constexpr std::size_t kBlock = 64;
+  const auto m = static_cast<std::size_t>(u.occluders.cols());
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> o = u.occluders.transpose();
   const double rho2 = rho * rho;
   int seen = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d seg = view - u.positions.col(i);
+    const Eigen::Vector3d p = u.positions.col(i);
+    const Eigen::Vector3d seg = view - p;
     if (u.normals.col(i).dot(seg) <= 0.0) continue;
     const double len2 = seg.squaredNorm();
     bool blocked = false;
-    for (Eigen::Index b = 0; b < u.occluders.cols() && !blocked; ++b) {
-      const Eigen::Vector3d rel = u.occluders.col(b) - u.positions.col(i);
-      const double t = std::clamp(rel.dot(seg) / len2, 0.0, 1.0);
-      blocked = (rel - t * seg).squaredNorm() < rho2;
+    for (std::size_t b = 0; b < m && !blocked; b += kBlock) {
+      blocked = any_near_segment(o.col(0).data() + b, o.col(1).data() + b, o.col(2).data() + b,
+                                 std::min(kBlock, m - b), p.x(), p.y(), p.z(), seg.x(), seg.y(), seg.z(),
+                                 len2, rho2);
     }
     seen += blocked ? 0 : 1;
   }

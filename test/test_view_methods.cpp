@@ -67,6 +67,33 @@ TEST(ViewMethods, FacingAwaySupervoxelsAreUnseen) {
   EXPECT_EQ(score_view(p, c, 0.5, Eigen::Vector3d(0, 0, 1), 0.015).visible_fraction, 0.0);
 }
 
+TEST(ViewMethods, AnOccluderBlocksALineOfSightWithinItsRadiusWhereverItIsInTheList) {
+  // One supervoxel at the origin facing the camera at (0, 0, 1). 150
+  // occluders far off the line of sight, and one at (d, 0, 0.5): it blocks
+  // when d < rho, at every place in the list (the test runs in blocks).
+  ViewProblem p;
+  p.positions = Eigen::Matrix3Xd::Zero(3, 1);
+  p.normals = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d camera(0, 0, 1);
+  const double rho = 0.02;
+  for (const int where : {0, 63, 64, 65, 127, 150}) {
+    for (const double d : {0.019, 0.021}) {
+      p.occluders.resize(3, 151);
+      for (int k = 0; k < 151; ++k) p.occluders.col(k) << 0.3, 0.01 * k - 0.75, 0.5;
+      p.occluders.col(where) << d, 0.0, 0.5;
+      EXPECT_EQ(score_view(p, c, 1.0, camera, rho).visible_fraction, d < rho ? 0.0 : 1.0)
+          << "occluder " << where << " at " << d;
+    }
+  }
+  // Past either end of the segment the distance is to the end point.
+  p.occluders.resize(3, 1);
+  p.occluders.col(0) << 0.015, 0.0, 1.01;  // 0.018 from the camera
+  EXPECT_EQ(score_view(p, c, 1.0, camera, rho).visible_fraction, 0.0);
+  p.occluders.col(0) << 0.015, 0.0, 1.015;  // 0.021 from the camera
+  EXPECT_EQ(score_view(p, c, 1.0, camera, rho).visible_fraction, 1.0);
+}
+
 TEST(ViewMethods, AngularErrorIsTheAngleToEachRayFromTheCentroid) {
   // Two supervoxels at C facing +z and +x: rays along +z and +x. A camera
   // 30 degrees from +z towards +x is 30 and 60 degrees off them (eq. 9).
