@@ -35,4 +35,24 @@ inline ViewProblem flat_patch_with_occluders(int n, int b, unsigned seed = 7) {
   return p;
 }
 
+/**
+ * \brief The loop's largest problems (`sweep` with anticipation): a patch of
+ *        `n` supervoxels as flat_patch_with_occluders(), and an upright arm
+ *        of `b` occluder points between it and the sphere, spread over three
+ *        places 0.18 m apart (the arm now and its two predicted copies), with
+ *        the previous view beyond them: the warm start crosses their rays.
+ */
+inline ViewProblem patch_behind_sweeping_arm(int n, int b, unsigned seed = 7) {
+  ViewProblem p = flat_patch_with_occluders(n, 0, seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  p.occluders.resize(3, b);
+  for (int k = 0; k < b; ++k) {
+    const double x = -0.1 + 0.18 * (k % 3);
+    p.occluders.col(k) << x + 0.035 * unit(rng), 0.18 * unit(rng), 0.78 + 0.035 * unit(rng);
+  }
+  p.previous_view = Eigen::Vector3d(0.3, 0.0, 0.6);
+  return p;
+}
+
 }  // namespace ofv::bench

@@ -14,8 +14,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -647,18 +645,42 @@ Projection project(const PointRows& pts, const Eigen::Vector3d& t_from_c, double
   return p;
 }
 
-// Marks the n points closer than sqrt(keep2) to t (1, else 0); returns how many.
-OFV_POINT_KERNEL std::size_t mark_within(const double* x, const double* y, const double* z, std::size_t n,
-                                         double tx, double ty, double tz, double keep2, unsigned char* in) {
+// How many of the n points are closer than sqrt(keep2) to t.
+OFV_POINT_KERNEL std::size_t count_within(const double* x, const double* y, const double* z,
+                                          std::size_t n, double tx, double ty, double tz,
+                                          double keep2) {
   std::size_t kept = 0;
 #pragma omp simd reduction(+ : kept)
   for (std::size_t k = 0; k < n; ++k) {
     const double ex = x[k] - tx, ey = y[k] - ty, ez = z[k] - tz;
-    const unsigned char near = ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
-    in[k] = near;
-    kept += near;
+    kept += ex * ex + ey * ey + ez * ez < keep2 ? 1 : 0;
   }
   return kept;
+}
+
+// Copies the points of `rows` rows closer than sqrt(keep2) to t into `kept`,
+// each lane's in order into the same lane; lane_rows[l] = how many lane l kept.
+// Row by row, in memory order: the kept points are near each other (one
+// supervoxel's rays through one occluder cluster), so most rows keep none.
+OFV_POINT_KERNEL void keep_within(const double* x, const double* y, const double* z, std::size_t rows,
+                                  double tx, double ty, double tz, double keep2, double* kx, double* ky,
+                                  double* kz, std::size_t (&lane_rows)[kLanes]) {
+  std::fill(lane_rows, lane_rows + kLanes, std::size_t{0});
+  for (std::size_t row = 0; row < rows; ++row) {
+    const std::size_t first = row * kLanes;
+    unsigned in = 0;
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      const double ex = x[first + l] - tx, ey = y[first + l] - ty, ez = z[first + l] - tz;
+      in |= (ex * ex + ey * ey + ez * ez < keep2 ? 1u : 0u) << l;
+    }
+    for (std::size_t l = 0; in != 0; ++l, in >>= 1) {
+      if ((in & 1u) == 0) continue;
+      const std::size_t to = lane_rows[l]++ * kLanes + l;
+      kx[to] = x[first + l];
+      ky[to] = y[first + l];
+      kz[to] = z[first + l];
+    }
+  }
 }
 
 // Pruning. A point d on the sphere at angle a < 90 deg from w projects at
@@ -706,31 +728,13 @@ class PrunedPoints {
     const double* y = a.y;
     const double* z = a.z;
     const double tx = t_from_c.x(), ty = t_from_c.y(), tz = t_from_c.z();
-    in_.resize(n);
-    const std::size_t n_keep = mark_within(x, y, z, n, tx, ty, tz, keep2, in_.data());
-    use_all_ = n_keep * 2 > n;
+    use_all_ = count_within(x, y, z, n, tx, ty, tz, keep2) * 2 > n;
     if (use_all_) return;
     // Each lane keeps its own points in order, so each partial sum of §4
-    // meets the same non-zero terms in the same order. Row by row, in
-    // memory order; the kept points are near each other (one supervoxel's
-    // rays through one occluder cluster), so most rows keep none.
-    std::size_t lane_rows[kLanes] = {};
+    // meets the same non-zero terms in the same order.
+    std::size_t lane_rows[kLanes];
     kept_.reserve_rows(a.rows);
-    for (std::size_t row = 0; row < a.rows; ++row) {
-      const unsigned char* in = in_.data() + row * kLanes;
-      static_assert(kLanes == sizeof(std::uint64_t), "a row's marks are read as one word");
-      std::uint64_t any = 0;
-      std::memcpy(&any, in, kLanes);
-      if (any == 0) continue;
-      for (std::size_t l = 0; l < kLanes; ++l) {
-        if (in[l] == 0) continue;
-        const std::size_t k = row * kLanes + l;
-        const std::size_t to = lane_rows[l]++ * kLanes + l;
-        kept_.x[to] = x[k];
-        kept_.y[to] = y[k];
-        kept_.z[to] = z[k];
-      }
-    }
+    keep_within(x, y, z, a.rows, tx, ty, tz, keep2, kept_.x, kept_.y, kept_.z, lane_rows);
     kept_.rows = *std::max_element(lane_rows, lane_rows + kLanes);
     for (std::size_t l = 0; l < kLanes; ++l) {  // pad with d = 0 (no image)
       for (std::size_t m = lane_rows[l]; m < kept_.rows; ++m) {
@@ -747,7 +751,6 @@ class PrunedPoints {
   bool valid_ = false;
   bool use_all_ = true;
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
-  std::vector<unsigned char> in_;  // the mark of each point at the last selection
   PointRows kept_;
 };
 
