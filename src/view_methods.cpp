@@ -23,10 +23,11 @@ double mean_error_deg(const UsableInput& u, const Eigen::Vector3d& c, const Eige
   return u.rays.cols() > 0 ? error / static_cast<double>(u.rays.cols()) * kRadToDeg : 0.0;
 }
 
-// Whether one of the n occluders (o - p by coordinate) lies closer than
-// sqrt(rho2) to the segment from p to p + seg (len2 = |seg|^2): rel - t seg,
-// t = rel . seg / len2 clamped to [0, 1], computed as Eigen computes it for
-// one Vector3d (x + (y + z) for dot products).
+// Whether one of the n occluders (by coordinate) lies closer than sqrt(rho2)
+// to the segment from p to p + seg (len2 = |seg|^2): |rel - t seg|, rel =
+// o - p, t = rel . seg / len2 clamped to [0, 1], summed as Eigen sums a
+// Vector3d's dot product and squared norm, (x + y) + z, so that the result
+// is that of the plain Eigen expression.
 OFV_POINT_KERNEL bool any_near_segment(const double* x, const double* y, const double* z, std::size_t n,
                                        double px, double py, double pz, double sx, double sy, double sz,
                                        double len2, double rho2) {
@@ -34,10 +35,10 @@ OFV_POINT_KERNEL bool any_near_segment(const double* x, const double* y, const d
 #pragma omp simd reduction(| : near)
   for (std::size_t b = 0; b < n; ++b) {
     const double rx = x[b] - px, ry = y[b] - py, rz = z[b] - pz;
-    double t = (rx * sx + (ry * sy + rz * sz)) / len2;
+    double t = ((rx * sx + ry * sy) + rz * sz) / len2;
     t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     const double dx = rx - t * sx, dy = ry - t * sy, dz = rz - t * sz;
-    near |= dx * dx + (dy * dy + dz * dz) < rho2 ? 1 : 0;
+    near |= (dx * dx + dy * dy) + dz * dz < rho2 ? 1 : 0;
   }
   return near != 0;
 }

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 namespace ofv {
 namespace {
 
@@ -92,6 +96,32 @@ TEST(ViewMethods, AnOccluderBlocksALineOfSightWithinItsRadiusWhereverItIsInTheLi
   EXPECT_EQ(score_view(p, c, 1.0, camera, rho).visible_fraction, 0.0);
   p.occluders.col(0) << 0.015, 0.0, 1.015;  // 0.021 from the camera
   EXPECT_EQ(score_view(p, c, 1.0, camera, rho).visible_fraction, 1.0);
+}
+
+// At exactly rho the line of sight is clear: the distance is computed to the
+// last bit as the plain Eigen expression computes it.
+TEST(ViewMethods, AnOccluderExactlyAtTheRadiusDoesNotBlock) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int cases = 0;
+  for (int k = 0; k < 4000; ++k) {
+    const Eigen::Vector3d p(0.1 * u(rng), 0.1 * u(rng), 0.5 + 0.1 * u(rng));
+    const Eigen::Vector3d view(0.3 * u(rng), 0.3 * u(rng), 0.05 * u(rng));
+    const Eigen::Vector3d seg = view - p;
+    const Eigen::Vector3d o = p + (0.5 + 0.6 * u(rng)) * seg + Eigen::Vector3d(0.03 * u(rng), 0.03 * u(rng), 0.0);
+    const Eigen::Vector3d rel = o - p;
+    const double t = std::clamp(rel.dot(seg) / seg.squaredNorm(), 0.0, 1.0);
+    const double d2 = (rel - t * seg).squaredNorm();
+    const double rho = std::sqrt(d2);
+    if (rho * rho != d2) continue;
+    ViewProblem prob;
+    prob.positions = p;
+    prob.normals = seg;
+    prob.occluders = o;
+    ASSERT_EQ(score_view(prob, p, 10.0, view, rho).visible_fraction, 1.0) << "case " << k;
+    ++cases;
+  }
+  EXPECT_GT(cases, 500);
 }
 
 TEST(ViewMethods, AngularErrorIsTheAngleToEachRayFromTheCentroid) {
