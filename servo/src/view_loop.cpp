@@ -346,7 +346,17 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   return held_->position;
 }
 
-std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& problem, const ViewEstimate& estimate) {
+std::optional<ViewEstimate> ViewLoop::from_previous_target(const ViewProblem& problem) const {
+  if (!settings_.target_hysteresis || !previous_target_) return std::nullopt;
+  ViewProblem from_previous = problem;
+  from_previous.previous_view = *previous_target_;
+  EstimatorSettings warm = estimator_;
+  warm.warm_start = true;
+  return estimate_view(from_previous, warm);
+}
+
+std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& problem, const ViewEstimate& estimate,
+                                                       const std::optional<ViewEstimate>& kept) {
   const double r_sphere = estimator_.r_sphere;
   switch (settings_.method) {
     case ViewMethod::Static: return std::nullopt;
@@ -370,14 +380,10 @@ std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& proble
     // t0 is occluded: continue from the previous target (the spec's warm
     // start), which stays where it is while clear and otherwise moves to
     // the nearest clear view. While t0 is clear, t0 is the target.
-    ViewProblem from_previous = problem;
-    from_previous.previous_view = *previous_target_;
-    EstimatorSettings warm = estimator_;
-    warm.warm_start = true;
-    const ViewEstimate kept = estimate_view(from_previous, warm);
-    if (is_free(kept.status)) {
-      status = kept.status;
-      target = kept.tf;
+    const std::optional<ViewEstimate> warm = kept ? kept : from_previous_target(problem);
+    if (is_free(warm->status)) {
+      status = warm->status;
+      target = warm->tf;
     }
   }
   if (!is_free(status) && settings_.no_free_view.mode == NoFreeView::MostVisible) {
@@ -424,6 +430,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     }
     const ViewProblem* basis = &*problem;
     ViewProblem ahead;
+    std::optional<ViewEstimate> kept;  // from the previous target, on `ahead`
     if (settings_.anticipation.mode == Anticipation::Predict) {
       const Eigen::Matrix3Xd future = predicted(out.estimate->centroid);
       if (future.cols() > 0) {
@@ -436,15 +443,32 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
         ahead.previous_view = out.estimate->tf;
         EstimatorSettings from_now = estimator_;
         from_now.warm_start = true;
-        ViewEstimate anticipated = estimate_view(ahead, from_now);
-        if (is_free(anticipated.status)) {
+        // That view stays the target if it is clear of the predicted
+        // occluders too (0 iterations: only whether the start is clear).
+        // Otherwise choose_target continues from the previous target and
+        // takes that if it is free: estimated first here, so that the
+        // search from the frame's view runs only when it is not.
+        from_now.max_iterations = 0;
+        std::optional<ViewEstimate> anticipated = estimate_view(ahead, from_now);
+        if (!is_free(anticipated->status)) {
+          kept = settings_.method == ViewMethod::Estimator ? from_previous_target(ahead) : std::nullopt;
+          if (kept && is_free(kept->status)) {
+            anticipated = kept;
+          } else {
+            from_now.max_iterations = estimator_.max_iterations;
+            anticipated = estimate_view(ahead, from_now);
+          }
+        }
+        if (is_free(anticipated->status)) {
           out.predicted_occluders = future.cols();
           out.anticipated = std::move(anticipated);
           basis = &ahead;
+        } else {
+          kept.reset();  // on `ahead`, not on the basis
         }
       }
     }
-    out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate);
+    out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate, kept);
     if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, *out.estimate, *shown, dt, out.target);
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;

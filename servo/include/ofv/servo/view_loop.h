@@ -109,7 +109,10 @@ struct LoopStep {
   SafetyAction safety = SafetyAction::None;    ///< what the safety filter did
   std::vector<OccluderTrack> tracks;  ///< the occluder tracks after this frame (confirmed or not)
   /// The estimate on the frame's occluders plus the predicted ones
-  /// (anticipation on, something moving, a free view found).
+  /// (anticipation on, something moving, a free view found): warm-started
+  /// from the frame's view (estimate->tf), or, when that view is not clear
+  /// of the predicted occluders and the previous target is, from the
+  /// previous target.
   std::optional<ViewEstimate> anticipated;
   Eigen::Index predicted_occluders = 0;  ///< predicted points added to the problem
   double estimate_s = 0.0;  ///< compute time of view selection [s]
@@ -152,7 +155,11 @@ class ViewLoop {
   [[nodiscard]] const EstimatorSettings& estimator() const { return estimator_; }
 
  private:
-  [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate);
+  /// `kept`: the warm start from the previous target on `problem`, when
+  /// already estimated (it is then not estimated again).
+  [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate,
+                                                             const std::optional<ViewEstimate>& kept = std::nullopt);
+  [[nodiscard]] std::optional<ViewEstimate> from_previous_target(const ViewProblem& problem) const;
   [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
   [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, const ViewEstimate& estimate,
                                                        double shown, double dt,
