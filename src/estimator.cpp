@@ -660,8 +660,7 @@ OFV_POINT_KERNEL std::size_t count_within(const double* x, const double* y, cons
 
 // Copies the points of `rows` rows closer than sqrt(keep2) to t into kx, ky,
 // kz, each lane's in order into the same lane; lane_rows[l] = how many lane l
-// kept.
-// Row by row, in memory order: the kept points are near each other (one
+// kept. Row by row, in memory order: the kept points are near each other (one
 // supervoxel's rays through one occluder cluster), so most rows keep none.
 OFV_POINT_KERNEL void keep_within(const double* x, const double* y, const double* z, std::size_t rows,
                                   double tx, double ty, double tz, double keep2, double* kx, double* ky,
