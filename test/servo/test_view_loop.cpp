@@ -126,22 +126,32 @@ enum class Loss {
   Follows,   // a cluster that moves with the camera, between it and the patch
 };
 
-// `settle` frames at the origin, then three on the way to the estimator's
-// view showing `shown_on_way` (of 100 at the origin); returns the last target.
-Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, double shown_on_way = 50.0) {
-  LoopSettings settings;
-  settings.no_free_view.retreat_drop = retreat_drop;
-  ViewLoop loop(settings);
-  const double dt = 1.0 / 30.0;
+// The patch with a small cluster in front of a corner (side 1: +x +y, -1:
+// -x -y): t0 is occluded, the estimator converges to the same view frame
+// after frame.
+ViewProblem occluded_patch(double side = 1.0) {
   ViewProblem start = patch(false);
   start.occluders.resize(3, 9);
-  for (int k = 0; k < 9; ++k) start.occluders.col(k) << (k % 3 - 1) * 0.01 + 0.02, (k / 3 - 1) * 0.01 + 0.02, 0.3;
+  for (int k = 0; k < 9; ++k) {
+    start.occluders.col(k) << (k % 3 - 1) * 0.01 + 0.02 * side, (k / 3 - 1) * 0.01 + 0.02 * side, 0.3;
+  }
+  return start;
+}
+
+// `frames` frames at the origin showing 100; returns the last target.
+Eigen::Vector3d stay(ViewLoop& loop, int frames, double side = 1.0) {
   LoopStep s;
-  for (int k = 0; k < settle; ++k) s = loop.step(start, vpHomogeneousMatrix(), dt, 0.0, /*shown=*/100.0);
+  for (int k = 0; k < frames; ++k) s = loop.step(occluded_patch(side), vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, 100.0);
   EXPECT_TRUE(s.target);
-  const Eigen::Vector3d away = *s.target;
-  EXPECT_GT(away.norm(), 0.05);
+  return s.target.value_or(Eigen::Vector3d::Constant(NAN));
+}
+
+// Three frames on the way to `away` showing `shown_on_way` (of 100 at the
+// origin); returns the last target.
+Eigen::Vector3d leave(ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, double shown_on_way, double side = 1.0) {
   const Eigen::Vector3d object(0, 0, 0.5);
+  const ViewProblem start = occluded_patch(side);
+  LoopStep s;
   for (int k = 1; k <= 3; ++k) {
     const Eigen::Vector3d camera = away * 0.3 * k;  // on its way
     Eigen::Vector3d cluster = 0.5 * (camera + object);
@@ -152,10 +162,21 @@ Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, do
     p.occluders.conservativeResize(3, 9 + 49);
     for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = cluster + spacing * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
     s = loop.step(p, vpHomogeneousMatrix(vpTranslationVector(camera.x(), camera.y(), camera.z()), vpRotationMatrix()),
-                  dt, 0.0, shown_on_way);
+                  1.0 / 30.0, 0.0, shown_on_way);
     EXPECT_TRUE(s.target);
   }
   return s.target.value_or(Eigen::Vector3d::Constant(NAN));
+}
+
+// `settle` frames at the origin, then three on the way to the estimator's
+// view; returns the last target.
+Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, double shown_on_way = 50.0) {
+  LoopSettings settings;
+  settings.no_free_view.retreat_drop = retreat_drop;
+  ViewLoop loop(settings);
+  const Eigen::Vector3d away = stay(loop, settle);
+  EXPECT_GT(away.norm(), 0.05);
+  return leave(loop, away, loss, shown_on_way);
 }
 
 TEST(ViewLoop, RetreatsWhenItsOwnMotionHidesTheObject) {
@@ -180,6 +201,27 @@ TEST(ViewLoop, OnTheWayToASteadyFreeViewOnlyLosingMoreThanHalfRetreats) {
   EXPECT_LT(after_leaving(0.2, Loss::Revealed, 12, 40.0).norm(), 1e-12);
   // Without the steady frames, 40 % is enough.
   EXPECT_LT(after_leaving(0.2, Loss::Revealed, 1, 60.0).norm(), 1e-12);
+}
+
+TEST(ViewLoop, AfterASteadyViewFailedSteadinessNoLongerEndsAHold) {
+  // The first hold began before the target was steady: back at the origin,
+  // ten frames converging to the same view end it. The camera leaves for
+  // another view (an occluder on the other side: not steady yet) and loses
+  // 60 % again: that hold is not ended by steadiness (a steady view
+  // failed), only by t0 becoming clear.
+  LoopSettings settings;
+  settings.no_free_view.retreat_drop = 0.2;
+  ViewLoop loop(settings);
+  const Eigen::Vector3d away = stay(loop, 1);
+  ASSERT_LT(leave(loop, away, Loss::Revealed, 40.0).norm(), 1e-12);
+  EXPECT_LT(stay(loop, 5).norm(), 1e-12);           // held
+  ASSERT_LT((stay(loop, 10) - away).norm(), 1e-9);  // steady: released
+  const Eigen::Vector3d other = stay(loop, 1, -1.0);
+  ASSERT_GT((other - away).norm(), 0.1);
+  ASSERT_LT(leave(loop, other, Loss::Revealed, 40.0, -1.0).norm(), 1e-12);
+  EXPECT_LT(stay(loop, 30, -1.0).norm(), 1e-12);  // held, however steady
+  (void)loop.step(patch(false), vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, 100.0);  // t0 clear: the hold ends
+  EXPECT_LT((stay(loop, 1, -1.0) - other).norm(), 1e-9);
 }
 
 TEST(ViewLoop, SettingsByNameAreValidated) {
