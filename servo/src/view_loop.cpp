@@ -453,17 +453,17 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
         // takes that if it is free: estimated first here, so that the
         // search from the frame's view runs only when it is not.
         from_now.max_iterations = 0;
-        std::optional<ViewEstimate> anticipated = estimate_view(ahead, from_now);
-        if (!is_free(anticipated->status)) {
+        ViewEstimate anticipated = estimate_view(ahead, from_now);
+        if (!is_free(anticipated.status)) {
           kept = settings_.method == ViewMethod::Estimator ? from_previous_target(ahead) : std::nullopt;
           if (kept && is_free(kept->status)) {
-            anticipated = kept;
+            anticipated = *kept;
           } else {
             from_now.max_iterations = estimator_.max_iterations;
             anticipated = estimate_view(ahead, from_now);
           }
         }
-        if (is_free(anticipated->status)) {
+        if (is_free(anticipated.status)) {
           out.predicted_occluders = future.cols();
           out.anticipated = std::move(anticipated);
           basis = &ahead;
