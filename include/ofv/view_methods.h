@@ -110,9 +110,10 @@ struct NoFreeViewSettings {
   /// (the estimator converging within 10 deg of the previous frame's target
   /// for 10 frames: a way around an occluder) only a loss of more than half
   /// counts, and a hold that began before the target was steady ends when
-  /// it is, unless steadiness ended the previous hold and t0 has not been
-  /// clear since (a steady view failed: in a still cage of occluders the
-  /// false gaps are steady too). 0 = off.
+  /// it is, but only once t0 has been clear: since the first frame (what
+  /// hid t0 from the start did not arrive, like a cage of occluders) and
+  /// since steadiness last ended a hold (a steady view failed: in a still
+  /// cage the false gaps are steady too). 0 = off.
   double retreat_drop = 0.1;
 };
 

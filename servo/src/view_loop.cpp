@@ -262,7 +262,7 @@ void ViewLoop::reset() {
   target_direction_.reset();
   steady_frames_ = 0;
   release_when_steady_ = false;
-  steady_released_ = false;
+  steadiness_ends_holds_ = false;
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, const ViewEstimate& estimate,
@@ -285,9 +285,11 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   // yet steady (an occluder arriving) ends when it is. Gaps that only
   // perception's noise opens (an object in a cage of occluders) mostly
   // move from frame to frame; a hold that began on the way to a steady
-  // target (it failed), or after a hold that steadiness ended (a steady
-  // target failed: in a still cage the gaps are steady too), is not ended
-  // by steadiness until t0 is clear again.
+  // target (it failed) is not ended by steadiness. Nor is any hold until
+  // t0 has been clear: since the first frame (until then no occluder has
+  // arrived: what hides t0 was there from the start, like a cage), and
+  // again after a hold that steadiness ended (a steady target failed: in
+  // a still cage the gaps are steady too).
   constexpr double kSteadyDeg = 10.0;
   constexpr int kSteadyFrames = 10;
   constexpr double kSteadyLoss = 0.5;
@@ -301,13 +303,13 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
     target_direction_.reset();
   }
   const bool steady = steady_frames_ >= kSteadyFrames;
-  if (estimate.iterations == 0) steady_released_ = false;
+  if (estimate.iterations == 0) steadiness_ends_holds_ = true;
   if (held_) {
     const bool there = (here - held_->position).norm() <= kAway;
     low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
     const bool hold = estimate.iterations > 0 && low_frames_ < kReleaseFrames;
     if (hold && !(steady && release_when_steady_)) return held_->position;
-    steady_released_ = hold;  // steadiness ended it
+    if (hold) steadiness_ends_holds_ = false;  // steadiness ended it
     held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
     best_seen_ = SeenView{here, shown, problem.occluders};
     low_frames_ = 0;
@@ -345,7 +347,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   const double margin = here_score < 0.5 ? 0.0 : 0.1;
   if (score(problem, best_seen_->position) < here_score + margin) return target;  // the occluders came there too
   held_ = best_seen_;
-  release_when_steady_ = !steady && !steady_released_;
+  release_when_steady_ = !steady && steadiness_ends_holds_;
   low_frames_ = 0;
   return held_->position;
 }
