@@ -80,6 +80,23 @@ TEST(Episode, LatencyDelaysEveryCommandByWholeFrames) {
                   .isApprox(now.steps[1].wMc.translation() - now.steps[0].wMc.translation(), 1e-9));
 }
 
+TEST(Episode, FullPerceptionTracksTheScenariosObjectWhateverIsAtTheImageCentre) {
+  // A hand covers the case's centre in the first frame. From the labels
+  // (select=labels, the default) perception tracks the case, and the camera
+  // stays on the sphere around it; left to itself (select=auto) it picks
+  // the hand, the cluster nearest the image centre, and the camera follows
+  // a sphere around the hand.
+  const std::string scenario = std::string(OFV_TEST_DATA_DIR) + "/loop/hand-over-case-at-start.yaml";
+  const auto run_full = [&](const std::string& select) {
+    return run_episode(resolve_episode(sim::load_scenario(scenario), {{"perception", "full"}, {"select", select}}));
+  };
+  const EpisodeOutcome labels = run_full("labels");
+  const EpisodeOutcome automatic = run_full("auto");
+  for (const StepRecord& s : labels.steps) EXPECT_NE(s.status, StepStatus::ObjectLost) << s.time;
+  EXPECT_LE(labels.metrics.max_sphere_distance_error, 0.02);
+  EXPECT_GT(automatic.metrics.max_sphere_distance_error, 0.1);
+}
+
 TEST(Episode, SettingsAreValidatedByName) {
   const sim::Scenario s = sim::load_scenario(kOnRay);
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{

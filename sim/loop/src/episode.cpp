@@ -38,6 +38,13 @@ SettingsTable<EpisodeSetup> make_table() {
                                                     {{"full", PerceptionMode::Full}, {"ground-truth", PerceptionMode::GroundTruth}});
         },
         [](const E& e) { return std::string(to_string(e.perception)); });
+  t.add({"select", "labels | auto", to_string(d.select), "",
+         "perception=full, simulation: how the first frame's object is found: the scenario's object from the "
+         "labels (as a user points it out), or the front end's cluster nearest the image centre (ofv run's default)"},
+        [](E& e, const std::string& v) {
+          e.select = parse_word<ObjectSelect>("select", v, {{"labels", ObjectSelect::Labels}, {"auto", ObjectSelect::Auto}});
+        },
+        [](const E& e) { return std::string(to_string(e.select)); });
   t.add({"duration", "number in (0, 86400]", "the scenario's", "s", "length of the episode (ofv run: stop after this much source time)"},
         [](E& e, const std::string& v) { e.duration = parse_number("duration", v, 0.0, kMaxEpisodeDuration, true); },
         [](const E& e) { return format_number(e.duration); });
@@ -116,6 +123,7 @@ long episode_frames(const EpisodeSetup& setup) {
 }  // namespace
 
 const char* to_string(PerceptionMode mode) { return mode == PerceptionMode::Full ? "full" : "ground-truth"; }
+const char* to_string(ObjectSelect select) { return select == ObjectSelect::Labels ? "labels" : "auto"; }
 
 const SettingsTable<EpisodeSetup>& episode_settings_table() {
   static const SettingsTable<EpisodeSetup> table = make_table();
@@ -147,8 +155,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   ViewLoop loop(setup.loop);
   sim::Renderer renderer(scenario);
   std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
-  std::optional<Perception> perception;
-  if (setup.perception == PerceptionMode::Full) perception.emplace(perception_settings(loop.estimator()));
+  std::optional<Perception> perception;  // full: made on the first frame, which may point out the object
 
   // Commands on their way to the robot, oldest first.
   std::deque<vpColVector> in_flight(static_cast<std::size_t>(setup.latency), vpColVector(6, 0.0));
@@ -173,6 +180,16 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     start = Clock::now();
     std::optional<ViewProblem> problem;
     std::optional<double> shown = rec.visible_fraction;  // ground truth: what the camera sees
+    if (setup.perception == PerceptionMode::Full && !perception) {
+      PerceptionSettings settings = perception_settings(loop.estimator());
+      if (setup.select == ObjectSelect::Labels) {
+        settings.selection.mode = ObjectSelection::Mode::Image;
+        settings.selection.mask.resize(rendered.labels.size());
+        std::transform(rendered.labels.begin(), rendered.labels.end(), settings.selection.mask.begin(),
+                       [](std::uint16_t label) { return label == sim::kLabelObject ? 1 : 0; });
+      }
+      perception.emplace(settings);
+    }
     if (perception) {
       PerceptionResult result = perception->process(rendered.frame);
       shown = shown_object(result);

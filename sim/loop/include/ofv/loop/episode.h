@@ -33,6 +33,14 @@ enum class PerceptionMode {
 /// \brief The mode's word in settings and files: full, ground-truth.
 [[nodiscard]] const char* to_string(PerceptionMode mode);
 
+/// \brief How full perception finds the object in the first frame.
+enum class ObjectSelect {
+  Labels,  ///< the scenario's object, as the first frame's labels show it (a user pointing it out)
+  Auto,    ///< the front end's own choice: the colour-consistent cluster nearest the image centre
+};
+/// \brief The word in settings and files: labels, auto.
+[[nodiscard]] const char* to_string(ObjectSelect select);
+
 /**
  * \brief Everything an episode needs, resolved and validated.
  *
@@ -45,6 +53,7 @@ struct EpisodeSetup {
   LoopSettings loop;  ///< the per-frame policy: estimator, method, controller, safety
   RobotKind robot = RobotKind::Camera;
   PerceptionMode perception = PerceptionMode::Full;
+  ObjectSelect select = ObjectSelect::Labels;  ///< full perception, simulation only
   double duration = 0.0;  ///< [s]
   unsigned seed = 0;      ///< the scenario's k-th random world (sim::with_seed)
   /// Frames between capturing a frame and applying its command: the robot
@@ -59,8 +68,8 @@ struct EpisodeSetup {
 
 /**
  * \brief Every setting of an episode by name: the loop's
- *        (ofv::loop_settings_table()) and robot, perception, duration, seed,
- *        latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        (ofv::loop_settings_table()) and robot, perception, select, duration,
+ *        seed, latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
 [[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();
