@@ -11,6 +11,10 @@
 #include <string>
 #include <vector>
 
+namespace ofv {
+struct ObjectSelection;
+}  // namespace ofv
+
 namespace ofv::cli {
 
 /// Exit codes shared by every subcommand.
@@ -52,6 +56,15 @@ Command add_run_command(CLI::App& app);
 
 /// Registers `ofv perceive` (perception front end + estimator over a source) on the app.
 Command add_perceive_command(CLI::App& app);
+
+/// Adds `--box` and `--rect` (exclusive): the object in the first frame, by
+/// a world box or an image rectangle (ofv perceive, ofv run).
+void add_selection_options(CLI::App& app, std::string& box, std::string& rect);
+
+/// The selection those options ask for; the front end's default without them.
+/// \throws std::invalid_argument naming the option when it is not six (box)
+///         or four (rect) comma-separated numbers.
+ObjectSelection object_selection(const std::string& box, const std::string& rect);
 
 /// Registers `ofv record` (a simulated episode exported as .oni/TUM/PCD) on the app.
 Command add_record_command(CLI::App& app);

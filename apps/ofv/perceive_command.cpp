@@ -14,7 +14,6 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -36,29 +35,6 @@ Output: with --out DIR, DIR/frame_NNNNNN.json per frame ({"frame", "timestamp", 
 --pictures, DIR/frame_NNNNNN.png; without --out, one JSON object per line on stdout.
 A summary goes to stderr. Exit 0 ok, 1 runtime failure, 2 bad input (one line on stderr).
 )";
-
-std::vector<double> parse_numbers(const std::string& text, std::size_t count,
-                                  const std::string& option) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    try {
-      std::size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size()) {
-        throw std::invalid_argument(item);
-      }
-    } catch (const std::exception&) {
-      throw std::invalid_argument(option + " " + text + ": '" + item + "' is not a number");
-    }
-  }
-  if (values.size() != count) {
-    throw std::invalid_argument(option + " " + text + ": expected " + std::to_string(count) +
-                                " comma-separated numbers");
-  }
-  return values;
-}
 
 /// What the user asked for, as parsed.
 struct Options {
@@ -84,18 +60,7 @@ PerceptionSettings perception_settings(const Options& opt, const EstimatorSettin
   ps.obb_margin = opt.obb_margin;
   ps.tracking.max_motion = opt.max_motion;
   ps.support_plane_occludes = !opt.no_plane_occluders;
-  if (!opt.box.empty()) {
-    const auto b = parse_numbers(opt.box, 6, "--box");
-    ps.selection.mode = ObjectSelection::Mode::Box;
-    ps.selection.box =
-        Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5]));
-  } else if (!opt.rect.empty()) {
-    const auto b = parse_numbers(opt.rect, 4, "--rect");
-    ps.selection.mode = ObjectSelection::Mode::Image;
-    ps.selection.rect =
-        Eigen::AlignedBox2i(Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
-                            Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
-  }
+  ps.selection = object_selection(opt.box, opt.rect);
   validate(ps);
   return ps;
 }
@@ -114,10 +79,7 @@ Command add_perceive_command(CLI::App& app) {
                   "Estimator setting name=value (repeatable); r_seed and r_sphere also set the "
                   "supervoxel seed resolution and the sphere of the front end")
       ->type_name("NAME=VALUE");
-  sub->add_option("--box", opt->box, "Select the object in frame 0 by a world box [m]")
-      ->type_name("X0,Y0,Z0,X1,Y1,Z1");
-  sub->add_option("--rect", opt->rect, "Select the object in frame 0 by an image rectangle [px]")
-      ->type_name("U0,V0,U1,V1");
+  add_selection_options(*sub, opt->box, opt->rect);
   sub->add_option("--max-frames", opt->max_frames, "Stop after this many frames");
   sub->add_option("--speed", opt->speed,
                   "Playback speed of .oni files: 1 real time, 0 fastest, -1 every frame")

@@ -22,6 +22,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -152,6 +153,7 @@ Command add_run_command(CLI::App& app) {
     std::string robot = "camera";
     std::string source;
     std::string emc;
+    std::string box, rect;
     std::vector<std::string> sets;
     bool dry_run = false;
     bool display = false;
@@ -169,6 +171,7 @@ Command add_run_command(CLI::App& app) {
   sub->add_option("--emc", opt->emc, "File with the camera-end-effector transform eMc: tx ty tz tux tuy tuz");
   sub->add_option("--set", opt->sets, "Any setting of 'ofv simulate' as name=value (repeatable), same defaults")
       ->type_name("NAME=VALUE");
+  add_selection_options(*sub, opt->box, opt->rect);
   sub->add_flag("--dry-run", opt->dry_run,
                 "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
 #if defined(OFV_HAVE_DISPLAY)
@@ -179,7 +182,8 @@ Command add_run_command(CLI::App& app) {
                 "as SIGTERM does. Needs an X display (exit 2 without one)");
 #endif
   sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits (0). The object is picked in the first frame "
-              "(the cluster nearest the image centre); when it is lost, or a frame is stale (older than stale_timeout "
+              "(--box, --rect, or else the cluster nearest the image centre; a sim: rehearsal takes the scenario's "
+              "object, select=labels); when it is lost, or a frame is stale (older than stale_timeout "
               "after the previous one, or not after it), the robot stops. An error mid-run (the source, perception or "
               "the robot fails) stops the robot, then is reported (exit 2 for an invalid recording, 1 otherwise). A dry "
               "run's lines are flushed one by one; the last one is always the stop.\n\n" +
@@ -195,6 +199,7 @@ Command add_run_command(CLI::App& app) {
             EpisodeSetup setup;
             std::unique_ptr<FrameSource> source;
             std::unique_ptr<CameraRobot> robot;
+            ObjectSelection selection;
 #if defined(OFV_HAVE_DISPLAY)
             std::unique_ptr<LiveDisplay> display;
 #endif
@@ -223,6 +228,11 @@ Command add_run_command(CLI::App& app) {
 #endif
               };
               if (simulated) {
+                if (!opt->box.empty() || !opt->rect.empty()) {
+                  throw std::invalid_argument(
+                      "--box and --rect are for recordings and sensors; a sim: rehearsal tracks the scenario's object "
+                      "(or, with --set select=auto, the cluster nearest the image centre)");
+                }
                 setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
                 setup.real_time = true;
                 if (setup.robot == RobotKind::Camera) {
@@ -233,9 +243,13 @@ Command add_run_command(CLI::App& app) {
                 setup.duration = std::numeric_limits<double>::infinity();
                 episode_settings_table().apply(setup, settings);
                 (void)ViewLoop(setup.loop);  // validates
-                if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time) {
-                  throw std::invalid_argument("settings perception, seed and real_time need --source sim:SCENARIO");
+                const bool select = std::any_of(settings.begin(), settings.end(), [](const auto& s) { return s.first == "select"; });
+                if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time || select) {
+                  throw std::invalid_argument(
+                      "settings perception, seed, real_time and select need --source sim:SCENARIO (--box or --rect "
+                      "point out the object of a recording or sensor)");
                 }
+                selection = object_selection(opt->box, opt->rect);
                 open_display();
                 const vpHomogeneousMatrix eMc = opt->emc.empty() ? vpHomogeneousMatrix() : read_eMc(opt->emc);
                 robot = real ? real_robot(opt->robot, eMc) : make_robot(setup.robot, vpHomogeneousMatrix());
@@ -276,6 +290,7 @@ Command add_run_command(CLI::App& app) {
               options.move_robot = !opt->dry_run || !real;  // simulated robots follow a dry run
               options.max_duration = setup.duration;
               options.stop = &g_stop;
+              options.selection = selection;
               const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
               lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost

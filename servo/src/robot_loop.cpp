@@ -14,7 +14,11 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
   using Clock = std::chrono::steady_clock;
   ViewLoop loop(settings);
   std::optional<Perception> perception;
-  if (!options.problem_source) perception.emplace(perception_settings(loop.estimator()));
+  if (!options.problem_source) {
+    PerceptionSettings front_end = perception_settings(loop.estimator());
+    front_end.selection = options.selection;
+    perception.emplace(front_end);
+  }
   const auto rest = [&] {
     if (options.move_robot) (void)robot.step(vpColVector(6, 0.0), 0.0);
   };

@@ -63,6 +63,16 @@ SettingsTable<EpisodeSetup> make_table() {
   return t;
 }
 
+// select=labels: the scenario's object as a frame's labels show it.
+ObjectSelection object_in(const std::vector<std::uint16_t>& labels) {
+  ObjectSelection selection;
+  selection.mode = ObjectSelection::Mode::Image;
+  selection.mask.resize(labels.size());
+  std::transform(labels.begin(), labels.end(), selection.mask.begin(),
+                 [](std::uint16_t label) { return label == sim::kLabelObject ? 1 : 0; });
+  return selection;
+}
+
 // What the simulator knows of a frame, for the metrics: visibility, distance
 // to the sphere, the angular error of the camera against the ground-truth
 // supervoxels. Returns the ground-truth problem (the input in ground-truth mode).
@@ -182,12 +192,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     std::optional<double> shown = rec.visible_fraction;  // ground truth: what the camera sees
     if (setup.perception == PerceptionMode::Full && !perception) {
       PerceptionSettings settings = perception_settings(loop.estimator());
-      if (setup.select == ObjectSelect::Labels) {
-        settings.selection.mode = ObjectSelection::Mode::Image;
-        settings.selection.mask.resize(rendered.labels.size());
-        std::transform(rendered.labels.begin(), rendered.labels.end(), settings.selection.mask.begin(),
-                       [](std::uint16_t label) { return label == sim::kLabelObject ? 1 : 0; });
-      }
+      if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.labels);
       perception.emplace(settings);
     }
     if (perception) {
@@ -238,6 +243,13 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     options.problem_source = [&](const RgbdFrame& frame) -> std::optional<ViewProblem> {
       return renderer.ground_truth_problem(frame.wMc, estimator.r_seed, estimator.r_sphere);
     };
+  } else if (setup.select == ObjectSelect::Labels) {
+    // The first frame's labels, rendered from where the arm starts.
+    sim::RenderedFrame first;
+    const sim::SensorSettings& sensor = renderer.scenario().sensor;
+    renderer.set_time(0.0);
+    renderer.render(to_eigen(robot->wMc()), 0, sensor.intrinsics, sensor.noise.enabled, first);
+    options.selection = object_in(first.labels);
   }
   EpisodeOutcome outcome;
   (void)run_on_robot(source, *robot, setup.loop, options, [&](const RobotLoopFrame& f) {

@@ -36,6 +36,10 @@ struct RobotLoopOptions {
   double first_period = 1.0 / 30.0;
   /// When set, stop as soon as it reads non-zero (a signal handler's flag).
   const volatile std::sig_atomic_t* stop = nullptr;
+  /// How perception finds the object in the first frame (a world box, an
+  /// image rectangle or mask); the default is the front end's own choice,
+  /// the cluster nearest the image centre.
+  ObjectSelection selection;
   /// When set, the estimator's input comes from here instead of the
   /// perception front end (simulated ground truth); std::nullopt = lost.
   std::function<std::optional<ViewProblem>(const RgbdFrame&)> problem_source;
