@@ -143,6 +143,26 @@ TEST(OneLoop, RehearsalRunsInWallClockTimeOnTheThreadedArm) {
   EXPECT_EQ(run("run --robot viper850 --source sim:no-such-scenario").code, 2);
 }
 
+TEST(OneLoop, RehearsalTracksTheScenariosObject) {
+  // As ofv simulate does: the hand over the case in the first frame is not
+  // taken for the object (select=labels), unless select=auto asks for the
+  // front end's own choice. Off the sphere around the case: a few mm, or
+  // the 0.2 m between the hand and the case.
+  const std::string rehearsal = "run --robot viper850 --source sim:" + std::string(OFV_SOURCE_DIR) +
+                                "/test/data/loop/hand-over-case-at-start.yaml";
+  const auto off_sphere_cm = [](const CommandRun& r) {
+    const std::string key = "distance to the sphere: max ";
+    const std::size_t at = r.out.find(key);
+    return at == std::string::npos ? NAN : std::stod(r.out.substr(at + key.size()));
+  };
+  const CommandRun labels = run(rehearsal);
+  const CommandRun automatic = run(rehearsal + " --set select=auto");
+  ASSERT_EQ(labels.code, 0) << labels.err;
+  ASSERT_EQ(automatic.code, 0) << automatic.err;
+  EXPECT_LT(off_sphere_cm(labels), 2.0) << labels.out;
+  EXPECT_GT(off_sphere_cm(automatic), 5.0) << automatic.out;
+}
+
 TEST(OneLoop, SignalsStopTheRobotAndEndTheRun) {
   for (const char* signal : {"INT", "TERM"}) {
     // Like Ctrl-C (INT) or a kill (TERM) 4 s into a 30 s run (start-up included: slow under sanitizers).
