@@ -19,6 +19,9 @@
 //!
 //! With a sensor, `ofv::run_on_robot(source, robot, settings, options)` runs
 //! this same loop (perception included) until Ctrl-C; `ofv run` is that call.
+//! `options.selection` points out the object in the first frame (a world box
+//! or an image rectangle, as `ofv run --box` / `--rect`); by default the
+//! front end takes the cluster nearest the image centre.
 #include <ofv/servo/robot.h>
 #include <ofv/servo/view_loop.h>
 #if defined(OFV_HAVE_DISPLAY)
