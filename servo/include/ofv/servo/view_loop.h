@@ -186,7 +186,7 @@ class ViewLoop {
   std::optional<Eigen::Vector3d> target_direction_;  ///< last converged target, unit vector from C
   int steady_frames_ = 0;              ///< frames in a row it stayed near the previous one
   bool release_when_steady_ = false;   ///< the hold began on the way to a target not yet steady
-  bool steadiness_ends_holds_ = false;  ///< t0 has been clear since the start and since steadiness last ended a hold
+  bool steadiness_ends_holds_ = false; ///< t0 was clear in some frame since steadiness last ended a hold (or since the start)
 };
 
 }  // namespace ofv
