@@ -147,7 +147,9 @@ TEST(OneLoop, RehearsalTracksTheScenariosObject) {
   // As ofv simulate does: the hand over the case in the first frame is not
   // taken for the object (select=labels), unless select=auto asks for the
   // front end's own choice. Off the sphere around the case: a few mm, or
-  // the 0.2 m between the hand and the case.
+  // the 0.2 m between the hand and the case. The arm runs in wall-clock
+  // time, so a slow build (sanitizers: 8 steps instead of 16) lags it by
+  // a few cm more; the bounds stay well apart from both.
   const std::string rehearsal = "run --robot viper850 --source sim:" + std::string(OFV_SOURCE_DIR) +
                                 "/test/data/loop/hand-over-case-at-start.yaml";
   const auto off_sphere_cm = [](const CommandRun& r) {
@@ -159,8 +161,8 @@ TEST(OneLoop, RehearsalTracksTheScenariosObject) {
   const CommandRun automatic = run(rehearsal + " --set select=auto");
   ASSERT_EQ(labels.code, 0) << labels.err;
   ASSERT_EQ(automatic.code, 0) << automatic.err;
-  EXPECT_LT(off_sphere_cm(labels), 2.0) << labels.out;
-  EXPECT_GT(off_sphere_cm(automatic), 5.0) << automatic.out;
+  EXPECT_LT(off_sphere_cm(labels), 6.0) << labels.out;
+  EXPECT_GT(off_sphere_cm(automatic), 12.0) << automatic.out;
 }
 
 TEST(OneLoop, SignalsStopTheRobotAndEndTheRun) {
