@@ -17,6 +17,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
   if (!options.problem_source) {
     PerceptionSettings front_end = perception_settings(loop.estimator());
     front_end.selection = options.selection;
+    front_end.beyond_view = settings.beyond_view;
     perception.emplace(front_end);
   }
   const auto rest = [&] {
@@ -49,6 +50,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       out.source_s = std::chrono::duration<double>(arrived - asked).count();
       std::optional<ViewProblem> problem;
       std::optional<double> shown;
+      Eigen::Index beyond_view = 0;
       PerceptionResult result;
       if (options.problem_source) {
         problem = options.problem_source(*frame);
@@ -56,11 +58,12 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
         result = perception->process(*frame);
         if (result.status != TrackingStatus::Lost) problem = result.problem;
         shown = shown_object(result);
+        beyond_view = static_cast<Eigen::Index>(result.counts.beyond_view);
         out.perception = &result;
       }
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       out.frame_age = options.wall_clock_age ? out.perception_s : gap;
-      const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age, shown);
+      const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age, shown, beyond_view);
       out.step = &step;
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
       // A period that is not finite and positive (a timestamp going backwards

@@ -22,6 +22,9 @@ using Clock = std::chrono::steady_clock;
 // predicted occluders). 12 MB.
 constexpr std::size_t kReservedOcclusionPoints = 250'000;
 
+constexpr double kAway = 0.01;     // [m]: the camera has moved from a view
+constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -117,6 +120,10 @@ SettingsTable<LoopSettings> make_table() {
          "time constant of a low-pass on the target position; 0 = off"},
         [](L& l, const std::string& v) { l.controller.target_filter = parse_number("target_filter", v, 0.0, 10.0, false); },
         [](const L& l) { return format_number(l.controller.target_filter); });
+  t.add({"beyond_view", "bool", format_bool(d.beyond_view), "",
+         "perception=full: an occluder the image border cuts goes on beyond it, to the sphere (false: only what the frame shows)"},
+        [](L& l, const std::string& v) { l.beyond_view = parse_bool("beyond_view", v); },
+        [](const L& l) { return format_bool(l.beyond_view); });
   t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",
          "while t0 is occluded, continue from the previous target (warm start) instead of re-estimating from t0"},
         [](L& l, const std::string& v) { l.target_hysteresis = parse_bool("target_hysteresis", v); },
@@ -263,6 +270,7 @@ void ViewLoop::reset() {
   steady_frames_ = 0;
   release_when_steady_ = false;
   steadiness_ends_holds_ = false;
+  last_centroid_.reset();
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, const ViewEstimate& estimate,
@@ -271,10 +279,8 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   const Eigen::Vector3d& c = estimate.centroid;
   const Eigen::Vector3d& here = *problem.camera;
   if (s.retreat_drop <= 0.0) return target;
-  constexpr double kAway = 0.01;  // [m]: the camera has moved from a view
   constexpr int kFrames = 2;      // a loss counts when it lasts this many frames (one frame is noise)
   constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
-  constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
   const double keep = 1.0 - s.retreat_drop;
   // A steady free view: the estimator converges, frame after frame, to a
   // target within kSteadyDeg of the previous frame's, for kSteadyFrames
@@ -352,6 +358,20 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   return held_->position;
 }
 
+std::optional<Eigen::Vector3d> ViewLoop::way_back(const Eigen::Vector3d& here, double dt) {
+  if (settings_.no_free_view.retreat_drop <= 0.0 || !last_centroid_) return std::nullopt;
+  if (!held_) {
+    if (!best_seen_) return std::nullopt;
+    best_seen_->age += dt;
+    if (!(best_seen_->age <= kEvidence)) return std::nullopt;  // not lost by the camera's recent motion
+    held_ = best_seen_;
+    release_when_steady_ = false;
+    low_frames_ = 0;
+  }
+  if ((here - held_->position).norm() <= kAway) return std::nullopt;  // back there: wait for perception
+  return held_->position;
+}
+
 std::optional<ViewEstimate> ViewLoop::from_previous_target(const ViewProblem& problem) const {
   if (!settings_.target_hysteresis || !previous_target_) return std::nullopt;
   ViewProblem from_previous = problem;
@@ -415,7 +435,7 @@ Eigen::Matrix3Xd ViewLoop::predicted(const Eigen::Vector3d& centroid) const {
 }
 
 LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
-                        double frame_age, std::optional<double> shown) {
+                        double frame_age, std::optional<double> shown, Eigen::Index untracked) {
   LoopStep out;
   reserve_estimator_memory(kReservedOcclusionPoints);  // once per thread
   auto start = Clock::now();
@@ -426,7 +446,12 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
   }
   if (!(std::isfinite(dt) && dt > 0.0)) tracker_.reset();  // no time base: start the tracks again
-  out.tracks = problem ? tracker_.update(problem->occluders, dt) : tracker_.coast(dt);
+  if (problem) {
+    const Eigen::Index seen = problem->occluders.cols() - std::clamp<Eigen::Index>(untracked, 0, problem->occluders.cols());
+    out.tracks = tracker_.update(problem->occluders.leftCols(seen), dt);
+  } else {
+    out.tracks = tracker_.coast(dt);
+  }
   if (out.estimate) {
     switch (out.estimate->status) {
       case ViewStatus::Converged: out.status = StepStatus::Converged; break;
@@ -478,14 +503,18 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, *out.estimate, *shown, dt, out.target);
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
+    last_centroid_ = out.estimate->centroid;
+  } else if (settings_.method == ViewMethod::Estimator) {
+    out.target = way_back(Eigen::Vector3d(wMc[0][3], wMc[1][3], wMc[2][3]), dt);
   }
   out.estimate_s = seconds_since(start);
 
   start = Clock::now();
   if (out.target) {
-    out.command = controller_.update(*out.target, out.estimate->centroid, estimator_.r_sphere, wMc, dt);
+    out.command = controller_.update(*out.target, *last_centroid_, estimator_.r_sphere, wMc, dt);
   }
-  out.velocity = safety_.filter(out.command, wMc, dt, out.estimate.has_value(), frame_age);
+  // Lost, the camera moves only on its way back (way_back).
+  out.velocity = safety_.filter(out.command, wMc, dt, out.estimate.has_value() || out.target.has_value(), frame_age);
   out.safety = safety_.last_action();
   out.control_s = seconds_since(start);
   return out;

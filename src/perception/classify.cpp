@@ -105,7 +105,7 @@ void Perception::Impl::hidden_vertices(ViewProblem& p, std::size_t seen) const {
   }
 }
 
-void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& object) {
+void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object) {
   const std::size_t n = r.supervoxels.size();
   // The object's voxel cloud: what is seen of it, plus the remembered voxels
   // of its part hidden behind something nearer the camera, so that an
@@ -177,6 +177,55 @@ void Perception::Impl::classify(PerceptionResult& r, const std::vector<char>& ob
   p.centroid = c;
   p.axes = axes;
   p.camera = r.wMc.translation();
+  if (settings.beyond_view) beyond_view(frame, r);
+}
+
+void Perception::Impl::beyond_view(const RgbdFrame& frame, PerceptionResult& r) const {
+  const CameraIntrinsics& k = frame.intrinsics;
+  const double seed = settings.supervoxels.seed_resolution;
+  // The continuation's spacing: seen from the object's many vertices, the
+  // occlusion points of neighbouring copies still overlap on the sphere.
+  const double step = 2.0 * seed;
+  const Eigen::Isometry3d cMw = r.wMc.inverse();
+  using Cell = Eigen::Matrix<std::int64_t, 3, 1>;
+  std::vector<std::pair<Cell, Eigen::Vector3d>> added;  // one per cell of `step`
+  for (const SupervoxelInfo& s : r.supervoxels) {
+    // The support plane is not continued: it goes on as a plane, not at one
+    // depth (its supervoxels at the border may have a poor normal: its colour tells).
+    if (s.label != SupervoxelClass::Occluder || on_plane(s) || plane_voxel(s.centroid.cast<float>(), s.colour)) {
+      continue;
+    }
+    const Eigen::Vector3d pc = cMw * s.centroid;
+    if (!(pc.z() > 1e-6)) continue;
+    // Within one seed resolution of a border, seen at this depth [px].
+    const double u = k.fx * pc.x() / pc.z() + k.cx;
+    const double v = k.fy * pc.y() / pc.z() + k.cy;
+    const double mu = k.fx * seed / pc.z();
+    const double mv = k.fy * seed / pc.z();
+    Eigen::Vector3d out = Eigen::Vector3d::Zero();  // outwards, camera frame
+    if (u < mu) out.x() = -1.0;
+    if (u > k.width - 1 - mu) out.x() = 1.0;
+    if (v < mv) out.y() = -1.0;
+    if (v > k.height - 1 - mv) out.y() = 1.0;
+    if (out.isZero()) continue;
+    out.normalize();
+    const int most = static_cast<int>(std::ceil(2.0 * settings.r_sphere / step));  // the sphere's diameter
+    for (int j = 1; j <= most; ++j) {
+      const Eigen::Vector3d q = r.wMc * (pc + (j * step) * out);
+      if (!((q - r.centroid).norm() < settings.r_sphere)) break;
+      if (!r.obb.contains(q)) added.emplace_back((q / step).array().floor().cast<std::int64_t>(), q);
+    }
+  }
+  std::sort(added.begin(), added.end(), [](const auto& a, const auto& b) {
+    return std::lexicographical_compare(a.first.data(), a.first.data() + 3, b.first.data(), b.first.data() + 3);
+  });
+  added.erase(std::unique(added.begin(), added.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+              added.end());
+  ViewProblem& p = r.problem;
+  const Eigen::Index seen = p.occluders.cols();
+  r.counts.beyond_view = added.size();
+  p.occluders.conservativeResize(3, seen + static_cast<Eigen::Index>(added.size()));
+  for (std::size_t j = 0; j < added.size(); ++j) p.occluders.col(seen + static_cast<Eigen::Index>(j)) = added[j].second;
 }
 
 }  // namespace ofv

@@ -161,7 +161,11 @@ struct Perception::Impl {
   /// hidden part moved by object_motion() first.
   void remember(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<char>& object);
   /// classify.cpp: C, axes, OBB, labels and r.problem.
-  void classify(PerceptionResult& r, const std::vector<char>& object);
+  void classify(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object);
+  /// classify.cpp: occluder points beyond the image border, where the
+  /// occluders the border cuts continue (PerceptionSettings::beyond_view),
+  /// appended to r.problem.occluders.
+  void beyond_view(const RgbdFrame& frame, PerceptionResult& r) const;
   /// classify.cpp: the remembered hidden voxels as vertices of p, after its
   /// `seen` columns (TrackingSettings::hidden_vertices).
   void hidden_vertices(ViewProblem& p, std::size_t seen) const;

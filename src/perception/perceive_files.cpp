@@ -28,7 +28,8 @@ nlohmann::ordered_json counts_json(const PerceptionCounts& c) {
           {"hidden_voxels", c.hidden_voxels},
           {"hidden_vertices", c.hidden_vertices},
           {"interacting", c.interacting},
-          {"occluders", c.occluders}};
+          {"occluders", c.occluders},
+          {"beyond_view", c.beyond_view}};
 }
 
 nlohmann::ordered_json timings_json(const PerceptionTimings& t, double estimate_ms) {

@@ -67,7 +67,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   // 4. Classification and the estimator's input.
   stage = std::chrono::steady_clock::now();
   if (r.status != TrackingStatus::Lost) {
-    classify(r, object);
+    classify(frame, r, object);
     centroid = r.centroid;
   }
   r.timings.classify = ms_since(stage);

@@ -177,6 +177,54 @@ TEST(Perception, ArmInFrontIsAnOccluderAndMovesTheView) {
   EXPECT_EQ(e.skipped_supervoxels, 0);
 }
 
+/// Distance from p to the segment a-b [m].
+double to_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * (b - a))).norm();
+}
+
+TEST(Perception, AnArmTheImageBorderCutsGoesOnBeyondIt) {
+  // A forearm along world x, across the view at a constant depth (the
+  // camera's x axis is world x): the left border cuts it 0.3 m from the camera.
+  const Eigen::Vector3d elbow(-0.6, -0.2, 0.1), wrist(-0.05, -0.2, 0.1);
+  const double radius = 0.025;
+  const Eigen::Isometry3d wMc = test::front_camera();
+  test::SyntheticScene scene = test::table_and_case();
+  const Frame clear = render(scene, wMc);
+  scene.shapes.push_back(test::make_capsule(elbow, wrist, radius, kSkin, kHand));
+  const Frame f = render(scene, wMc);
+  PerceptionSettings off;
+  off.beyond_view = false;
+  Perception with{PerceptionSettings{}}, without{off};
+  // The table alone, cut by every border, is not continued: it is the support plane.
+  ASSERT_EQ(with.process(clear.frame).status, TrackingStatus::Initialised);
+  ASSERT_EQ(without.process(clear.frame).status, TrackingStatus::Initialised);
+  const PerceptionResult r = with.process(f.frame);
+  const PerceptionResult plain = without.process(f.frame);
+  ASSERT_EQ(r.status, TrackingStatus::Tracking) << r.message;
+  ASSERT_EQ(plain.status, TrackingStatus::Tracking) << plain.message;
+  EXPECT_EQ(plain.counts.beyond_view, 0u);
+  EXPECT_EQ(static_cast<std::size_t>(plain.problem.occluders.cols()), plain.counts.occluders);
+  // The frame's own occluders come first, then the continuation.
+  ASSERT_GE(r.counts.beyond_view, 5u);
+  const auto seen = static_cast<Eigen::Index>(r.counts.occluders);
+  ASSERT_EQ(r.problem.occluders.cols(), seen + static_cast<Eigen::Index>(r.counts.beyond_view));
+  const CameraIntrinsics& k = f.frame.intrinsics;
+  const Eigen::Isometry3d cMw = wMc.inverse();
+  double leftmost = 0.0;
+  for (Eigen::Index i = seen; i < r.problem.occluders.cols(); ++i) {
+    const Eigen::Vector3d q = r.problem.occluders.col(i);
+    // Where the arm is, out of the image, inside the sphere.
+    EXPECT_LE(to_segment(q, elbow, wrist), radius + 0.02) << q.transpose();
+    const Eigen::Vector3d qc = cMw * q;
+    EXPECT_LT(k.fx * qc.x() / qc.z() + k.cx, 0.0) << q.transpose();
+    EXPECT_LT((q - r.centroid).norm(), PerceptionSettings{}.r_sphere);
+    leftmost = std::min(leftmost, q.x());
+  }
+  // It reaches the sphere: C is near the case, the arm leaves the sphere at x = -0.45.
+  EXPECT_LT(leftmost, -0.35);
+}
+
 TEST(Perception, FollowsAMovingDeformingObject) {
   Perception perception{PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();

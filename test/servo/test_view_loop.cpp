@@ -196,6 +196,72 @@ TEST(ViewLoop, RetreatsWhenItsOwnMotionHidesTheObject) {
   EXPECT_GT(after_leaving(0.2, Loss::Follows).norm(), 0.05);
 }
 
+vpHomogeneousMatrix at(const Eigen::Vector3d& p) { return vpHomogeneousMatrix(vpTranslationVector(p.x(), p.y(), p.z()), vpRotationMatrix()); }
+
+TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
+  // The origin showed the most (100); 6 cm away the frame shows 95, then
+  // perception loses the object: the camera heads back to the origin (the
+  // safety filter lets this motion through), and stops there.
+  const double dt = 1.0 / 30.0;
+  const Eigen::Vector3d away(0.06, 0.0, 0.0);
+  LoopSettings settings;
+  ViewLoop loop(settings);
+  (void)stay(loop, 1);
+  (void)loop.step(occluded_patch(), at(away), dt, 0.0, 95.0);
+  LoopStep s = loop.step(std::nullopt, at(away), dt, 0.0);
+  EXPECT_EQ(s.status, StepStatus::ObjectLost);
+  ASSERT_TRUE(s.target);
+  EXPECT_LT(s.target->norm(), 1e-12);
+  EXPECT_NE(s.safety, SafetyAction::ObjectLost);
+  EXPECT_LT(s.velocity[0], -1e-3);  // camera frame = world frame here: towards the origin
+  EXPECT_LE(speed(s.velocity), settings.safety.max_linear_speed + 1e-12);
+  s = loop.step(std::nullopt, at(Eigen::Vector3d(0.005, 0, 0)), dt, 0.0);
+  EXPECT_FALSE(s.target);
+  EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
+  EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+
+  // Without the retreat (retreat_drop = 0), or lost longer than 0.5 s after
+  // the view that showed the most, a lost object stops the camera.
+  settings.no_free_view.retreat_drop = 0.0;
+  ViewLoop no_retreat(settings);
+  (void)stay(no_retreat, 1);
+  (void)no_retreat.step(occluded_patch(), at(away), dt, 0.0, 95.0);
+  s = no_retreat.step(std::nullopt, at(away), dt, 0.0);
+  EXPECT_FALSE(s.target);
+  EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+  ViewLoop late(LoopSettings{});
+  (void)stay(late, 1);
+  for (int k = 0; k < 20; ++k) (void)late.step(occluded_patch(), at(away), dt, 0.0, 95.0);
+  s = late.step(std::nullopt, at(away), dt, 0.0);
+  EXPECT_FALSE(s.target);
+  EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+}
+
+TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
+  // The problem's last 30 occluders are presumed (perception's continuation
+  // beyond the image border): the estimator avoids them, the tracks leave them out.
+  ViewProblem p = occluded_patch();
+  p.occluders.conservativeResize(3, 9 + 30);
+  for (int i = 0; i < 30; ++i) p.occluders.col(9 + i) << -0.2 - 0.02 * (i % 10), 0.02 * (i / 10), 0.3;
+  const auto tracked_points = [](const LoopStep& s) {
+    Eigen::Index n = 0;
+    for (const OccluderTrack& t : s.tracks) n += t.points.cols();
+    return n;
+  };
+  ViewLoop with(LoopSettings{}), all(LoopSettings{});
+  LoopStep a, b;
+  for (int k = 0; k < 3; ++k) {
+    a = with.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, std::nullopt, 30);
+    b = all.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0);
+  }
+  EXPECT_EQ(tracked_points(a), 9);
+  EXPECT_EQ(tracked_points(b), 39);
+  ASSERT_TRUE(a.estimate && b.estimate);
+  EXPECT_EQ(a.estimate->occlusion_points, b.estimate->occlusion_points);
+  // More than the problem holds is all of it.
+  EXPECT_EQ(tracked_points(with.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, std::nullopt, 1000)), 0);
+}
+
 TEST(ViewLoop, OnTheWayToASteadyFreeViewOnlyLosingMoreThanHalfRetreats) {
   // The estimator has converged to the same view for 12 frames (a way
   // around an occluder): losing 40 % on the way there is no reason to go

@@ -135,6 +135,14 @@ struct PerceptionSettings {
   /// found in the first frame are background (as the simulator's
   /// ground-truth problem, which lists only occluding bodies).
   bool support_plane_occludes = true;
+  /// An occluder the image border cuts goes on beyond it (a hand's arm, a
+  /// tool's handle): the sensor only sees where it enters the view. Each
+  /// occluder supervoxel within one seed resolution of the border is
+  /// continued outwards, at its depth, every seed resolution until it
+  /// leaves the sphere; the estimator so does not look for a view through
+  /// the part of the arm it cannot see. false: only what the frame shows
+  /// (the paper's reading).
+  bool beyond_view = true;
   ObjectSelection selection;
 };
 
@@ -180,6 +188,7 @@ struct PerceptionCounts {
   std::size_t object = 0;
   std::size_t interacting = 0;
   std::size_t occluders = 0;
+  std::size_t beyond_view = 0;  ///< occluder points added beyond the image border (PerceptionSettings::beyond_view)
   std::size_t object_voxels = 0;  ///< seen in this frame
   std::size_t hidden_voxels = 0;  ///< remembered behind occluders, added to the object cloud
   std::size_t hidden_vertices = 0;  ///< vertices of the remembered hidden voxels added to the problem (hidden_vertices)

@@ -190,14 +190,17 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     start = Clock::now();
     std::optional<ViewProblem> problem;
     std::optional<double> shown = rec.visible_fraction;  // ground truth: what the camera sees
+    Eigen::Index beyond_view = 0;
     if (setup.perception == PerceptionMode::Full && !perception) {
       PerceptionSettings settings = perception_settings(loop.estimator());
+      settings.beyond_view = setup.loop.beyond_view;
       if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.labels);
       perception.emplace(settings);
     }
     if (perception) {
       PerceptionResult result = perception->process(rendered.frame);
       shown = shown_object(result);
+      beyond_view = static_cast<Eigen::Index>(result.counts.beyond_view);
       if (result.status != TrackingStatus::Lost) problem = std::move(result.problem);
     } else {
       problem = std::move(gt_problem);
@@ -205,7 +208,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     rec.times.perception = seconds_since(start);
 
     // The frame is as old as 1 + latency periods when its command is replaced.
-    const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency), shown);
+    const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency), shown, beyond_view);
     record_step(rec, step);
 
     outcome.steps.push_back(rec);

@@ -85,6 +85,9 @@ struct LoopSettings {
   /// view; once t0 is clear again, t0 is the target. The sampling planner
   /// keeps its previous view while it sees as much as the new best.
   bool target_hysteresis = true;
+  /// The front end's PerceptionSettings::beyond_view, where the loop makes
+  /// the front end (simulation with perception=full, ofv::run_on_robot).
+  bool beyond_view = true;
   AnticipationSettings anticipation;
   TrackerSettings tracker;           ///< the occluder tracks anticipation uses
   NoFreeViewSettings no_free_view;   ///< what to do when the estimator finds no free view
@@ -143,9 +146,15 @@ class ViewLoop {
    *                  ofv::shown_object(), its voxels seen in the frame), or
    *                  std::nullopt when unknown: then the loop never
    *                  retreats (NoFreeViewSettings::retreat_drop).
+   * \param untracked  the last this many columns of the problem's occluders
+   *                  are presumed, not seen (perception's continuation
+   *                  beyond the image border, PerceptionCounts::beyond_view):
+   *                  the estimator avoids them, the occluder tracks leave
+   *                  them out.
    */
   [[nodiscard]] LoopStep step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
-                              double frame_age, std::optional<double> shown = std::nullopt);
+                              double frame_age, std::optional<double> shown = std::nullopt,
+                              Eigen::Index untracked = 0);
 
   /// \brief Forgets the previous view, target and command (a new run).
   void reset();
@@ -160,6 +169,9 @@ class ViewLoop {
   [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate,
                                                              const std::optional<ViewEstimate>& kept = std::nullopt);
   [[nodiscard]] std::optional<ViewEstimate> from_previous_target(const ViewProblem& problem) const;
+  /// The object lost within kEvidence of the view that showed the most (or
+  /// while holding one): that view, until the camera is back there.
+  [[nodiscard]] std::optional<Eigen::Vector3d> way_back(const Eigen::Vector3d& here, double dt);
   [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
   [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, const ViewEstimate& estimate,
                                                        double shown, double dt,
@@ -180,6 +192,7 @@ class ViewLoop {
   SafetyFilter safety_;
   OccluderTracker tracker_;
   std::optional<Eigen::Vector3d> previous_view_, previous_target_;
+  std::optional<Eigen::Vector3d> last_centroid_;  ///< C of the last frame that found the object
   std::optional<SeenView> best_seen_;  ///< the view that showed the most of the object
   std::optional<SeenView> held_;       ///< retreated there: hold
   int low_frames_ = 0;                 ///< frames in a row showing much less than best_seen_ or held_
