@@ -273,8 +273,9 @@ void ViewLoop::reset() {
   last_centroid_.reset();
 }
 
-std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, const ViewEstimate& estimate,
-                                                 double shown, double dt, const std::optional<Eigen::Vector3d>& target) {
+std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eigen::Index seen,
+                                                 const ViewEstimate& estimate, double shown, double dt,
+                                                 const std::optional<Eigen::Vector3d>& target) {
   const NoFreeViewSettings& s = settings_.no_free_view;
   const Eigen::Vector3d& c = estimate.centroid;
   const Eigen::Vector3d& here = *problem.camera;
@@ -317,7 +318,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
     if (hold && !(steady && release_when_steady_)) return held_->position;
     if (hold) steadiness_ends_holds_ = false;  // steadiness ended it
     held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
-    best_seen_ = SeenView{here, shown, problem.occluders};
+    best_seen_ = SeenView{here, shown, problem.occluders.leftCols(seen), 0.0, track_positions()};
     low_frames_ = 0;
     return target;
   }
@@ -325,7 +326,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   // What a view showed longer ago than kEvidence is no evidence any more
   // (the occluders move): the current view starts again.
   if (!best_seen_ || shown >= best_seen_->shown || !(best_seen_->age <= kEvidence)) {
-    best_seen_ = SeenView{here, shown, problem.occluders};
+    best_seen_ = SeenView{here, shown, problem.occluders.leftCols(seen), 0.0, track_positions()};
     low_frames_ = 0;
     return target;
   }
@@ -342,7 +343,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   // to stand still (revealed by the motion), here shows less than there by
   // retreat_drop too. Occluders that moved in since cost the object
   // wherever the camera is.
-  const Eigen::Matrix3Xd still = still_occluders(tracker_.tracks(), settings_.anticipation.min_speed);
+  const Eigen::Matrix3Xd still = revealed_still(*best_seen_);
   ViewProblem then = problem;
   then.occluders.resize(3, best_seen_->occluders.cols() + still.cols());
   then.occluders << best_seen_->occluders, still;
@@ -356,6 +357,25 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, con
   release_when_steady_ = !steady && steadiness_ends_holds_;
   low_frames_ = 0;
   return held_->position;
+}
+
+std::vector<std::pair<int, Eigen::Vector3d>> ViewLoop::track_positions() const {
+  std::vector<std::pair<int, Eigen::Vector3d>> out;
+  for (const OccluderTrack& t : tracker_.tracks()) out.emplace_back(t.id, t.position);
+  return out;
+}
+
+Eigen::Matrix3Xd ViewLoop::revealed_still(const SeenView& then) const {
+  // Farther than this since `then`, a track that stands still now came
+  // there (an arm that arrived and stopped): not revealed by the camera.
+  constexpr double kMovedSince = 0.05;  // [m]
+  std::vector<OccluderTrack> still;
+  for (const OccluderTrack& t : tracker_.tracks()) {
+    if (!is_still(t, settings_.anticipation.min_speed)) continue;
+    const auto was = std::find_if(then.tracks.begin(), then.tracks.end(), [&](const auto& p) { return p.first == t.id; });
+    if (was == then.tracks.end() || (t.position - was->second).norm() <= kMovedSince) still.push_back(t);
+  }
+  return still_occluders(still, settings_.anticipation.min_speed);
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::way_back(const Eigen::Vector3d& here, double dt) {
@@ -446,8 +466,10 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
   }
   if (!(std::isfinite(dt) && dt > 0.0)) tracker_.reset();  // no time base: start the tracks again
+  // The occluders seen in the frame: those presumed (untracked) come last.
+  const Eigen::Index seen =
+      problem ? problem->occluders.cols() - std::clamp<Eigen::Index>(untracked, 0, problem->occluders.cols()) : 0;
   if (problem) {
-    const Eigen::Index seen = problem->occluders.cols() - std::clamp<Eigen::Index>(untracked, 0, problem->occluders.cols());
     out.tracks = tracker_.update(problem->occluders.leftCols(seen), dt);
   } else {
     out.tracks = tracker_.coast(dt);
@@ -500,7 +522,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
       }
     }
     out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate, kept);
-    if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, *out.estimate, *shown, dt, out.target);
+    if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, seen, *out.estimate, *shown, dt, out.target);
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
     last_centroid_ = out.estimate->centroid;

@@ -173,18 +173,27 @@ class ViewLoop {
   /// while holding one): that view, until the camera is back there.
   [[nodiscard]] std::optional<Eigen::Vector3d> way_back(const Eigen::Vector3d& here, double dt);
   [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
-  [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, const ViewEstimate& estimate,
-                                                       double shown, double dt,
+  /// `seen`: the problem's first `seen` occluders were seen (the rest
+  /// presumed); only those are evidence of what a view showed.
+  [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, Eigen::Index seen,
+                                                       const ViewEstimate& estimate, double shown, double dt,
                                                        const std::optional<Eigen::Vector3d>& target);
 
   /// A camera position (world), how much of the object it showed, the
-  /// occluders of that frame, and how long ago that was.
+  /// occluders seen in that frame, how long ago that was and where the
+  /// occluder tracks were.
   struct SeenView {
     Eigen::Vector3d position;
     double shown = 0.0;
     Eigen::Matrix3Xd occluders;
     double age = 0.0;  ///< time since [s]
+    std::vector<std::pair<int, Eigen::Vector3d>> tracks;  ///< each track's id and position then
   };
+  [[nodiscard]] std::vector<std::pair<int, Eigen::Vector3d>> track_positions() const;
+  /// This frame's points of the tracks that stand still and stood where
+  /// they are when `then` was seen (or were not tracked then): what the
+  /// camera's motion may have revealed.
+  [[nodiscard]] Eigen::Matrix3Xd revealed_still(const SeenView& then) const;
 
   LoopSettings settings_;
   EstimatorSettings estimator_;
