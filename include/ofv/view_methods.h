@@ -98,8 +98,9 @@ struct NoFreeViewSettings {
   /// the loop remembers the camera position that showed the most of the
   /// object in the last 0.5 s. When the camera has moved away from it and
   /// shows this fraction of that less for two frames, because of its own
-  /// motion (with the occluders of that position's frame and this frame's
-  /// still ones, score_view shows this fraction less here than there), and
+  /// motion (with the occluders seen in that position's frame and this
+  /// frame's still ones that have not moved 5 cm since, score_view shows
+  /// this fraction less here than there), and
   /// this frame's occluders do not make that position worse than the
   /// current one, the camera goes back there and holds until t0 is clear
   /// again or, back there, it shows this fraction less for 6 frames in a
@@ -113,7 +114,9 @@ struct NoFreeViewSettings {
   /// it is, but only once t0 has been clear: since the first frame (what
   /// hid t0 from the start did not arrive, like a cage of occluders) and
   /// since steadiness last ended a hold (a steady view failed: in a still
-  /// cage the false gaps are steady too). 0 = off.
+  /// cage the false gaps are steady too). When perception loses the object
+  /// within 0.5 s of that position (or during a hold), the camera drives
+  /// back there and stops. 0 = off.
   double retreat_drop = 0.1;
 };
 

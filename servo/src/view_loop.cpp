@@ -197,7 +197,8 @@ SettingsTable<LoopSettings> make_table() {
   t.add({"retreat_drop", "number in [0, 1]", format_number(d.no_free_view.retreat_drop), "",
          "the fraction of the object the camera may see less, because it moved, than at the view that showed the "
          "most in the last 0.5 s, before it goes back there and holds (not when occluders moved in or came there "
-         "too; on the way to a steady free view, only a loss of more than half), 0 (off) to 1"},
+         "too; on the way to a steady free view, only a loss of more than half); the object lost soon after, it "
+         "drives back there too; 0 (off) to 1"},
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
   t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
