@@ -471,6 +471,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
   const Eigen::Index seen =
       problem ? problem->occluders.cols() - std::clamp<Eigen::Index>(untracked, 0, problem->occluders.cols()) : 0;
   if (problem) {
+    out.presumed_occluders = problem->occluders.cols() - seen;
     out.tracks = tracker_.update(problem->occluders.leftCols(seen), dt);
   } else {
     out.tracks = tracker_.coast(dt);

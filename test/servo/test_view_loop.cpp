@@ -298,10 +298,14 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
   }
   EXPECT_EQ(tracked_points(a), 9);
   EXPECT_EQ(tracked_points(b), 39);
+  EXPECT_EQ(a.presumed_occluders, 30);
+  EXPECT_EQ(b.presumed_occluders, 0);
   ASSERT_TRUE(a.estimate && b.estimate);
   EXPECT_EQ(a.estimate->occlusion_points, b.estimate->occlusion_points);
   // More than the problem holds is all of it.
-  EXPECT_EQ(tracked_points(with.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, std::nullopt, 1000)), 0);
+  const LoopStep c = with.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, std::nullopt, 1000);
+  EXPECT_EQ(tracked_points(c), 0);
+  EXPECT_EQ(c.presumed_occluders, 39);
 }
 
 TEST(ViewLoop, OnTheWayToASteadyFreeViewOnlyLosingMoreThanHalfRetreats) {

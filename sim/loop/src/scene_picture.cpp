@@ -50,9 +50,11 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
       if (a) cv::circle(img, *a, 2, {255, 160, 60}, cv::FILLED);
       if (a && b) cv::line(img, *a, *b, {200, 120, 60}, 1, cv::LINE_AA);
     }
+    // Seen occluders filled; those presumed beyond the image border (last) hollow.
+    const Eigen::Index seen = s.problem->occluders.cols() - (s.step ? s.step->presumed_occluders : 0);
     for (Eigen::Index i = 0; i < s.problem->occluders.cols(); ++i) {
       if (const auto a = p(s.problem->occluders.col(i))) {
-        cv::rectangle(img, *a - cv::Point(2, 2), *a + cv::Point(2, 2), {60, 60, 230}, cv::FILLED);
+        cv::rectangle(img, *a - cv::Point(2, 2), *a + cv::Point(2, 2), {60, 60, 230}, i < seen ? cv::FILLED : 1);
       }
     }
   }

@@ -118,6 +118,9 @@ struct LoopStep {
   /// previous target.
   std::optional<ViewEstimate> anticipated;
   Eigen::Index predicted_occluders = 0;  ///< predicted points added to the problem
+  /// The problem's last this many occluders were presumed, not seen
+  /// (step()'s `untracked`: perception's continuation beyond the image border).
+  Eigen::Index presumed_occluders = 0;
   double estimate_s = 0.0;  ///< compute time of view selection [s]
   double control_s = 0.0;   ///< compute time of controller and filter [s]
 };

@@ -44,7 +44,8 @@ struct SceneState {
 
 /**
  * \brief Draws the scene view, 640 x 480: object supervoxels and normals
- *        (blue), occluders (red), the sphere of radius `r_sphere`, C, the
+ *        (blue), occluders (red; hollow where presumed beyond the image
+ *        border, LoopStep::presumed_occluders), the sphere of radius `r_sphere`, C, the
  *        real camera and its path (white), t0 (yellow), tf (green), the
  *        target the controller follows where it differs from tf (magenta),
  *        each confirmed occluder track as an orange arrow to where it will
