@@ -195,23 +195,22 @@ void Perception::Impl::beyond_view(const RgbdFrame& frame, PerceptionResult& r) 
     if (s.label != SupervoxelClass::Occluder || on_plane(s) || plane_voxel(s.centroid.cast<float>(), s.colour)) {
       continue;
     }
-    const Eigen::Vector3d pc = cMw * s.centroid;
-    if (!(pc.z() > 1e-6)) continue;
+    double z = 0.0;
+    const auto px = detail::project(frame, cMw, s.centroid, &z);
+    if (!px) continue;
     // Within one seed resolution of a border, seen at this depth [px].
-    const double u = k.fx * pc.x() / pc.z() + k.cx;
-    const double v = k.fy * pc.y() / pc.z() + k.cy;
-    const double mu = k.fx * seed / pc.z();
-    const double mv = k.fy * seed / pc.z();
+    const double mu = k.fx * seed / z;
+    const double mv = k.fy * seed / z;
     Eigen::Vector3d out = Eigen::Vector3d::Zero();  // outwards, camera frame
-    if (u < mu) out.x() = -1.0;
-    if (u > k.width - 1 - mu) out.x() = 1.0;
-    if (v < mv) out.y() = -1.0;
-    if (v > k.height - 1 - mv) out.y() = 1.0;
+    if (px->x() < mu) out.x() = -1.0;
+    if (px->x() > k.width - 1 - mu) out.x() = 1.0;
+    if (px->y() < mv) out.y() = -1.0;
+    if (px->y() > k.height - 1 - mv) out.y() = 1.0;
     if (out.isZero()) continue;
     out.normalize();
     const int most = static_cast<int>(std::ceil(2.0 * settings.r_sphere / step));  // the sphere's diameter
     for (int j = 1; j <= most; ++j) {
-      const Eigen::Vector3d q = r.wMc * (pc + (j * step) * out);
+      const Eigen::Vector3d q = s.centroid + (j * step) * (r.wMc.linear() * out);
       if (!((q - r.centroid).norm() < settings.r_sphere)) break;
       if (!r.obb.contains(q)) added.emplace_back((q / step).array().floor().cast<std::int64_t>(), q);
     }
