@@ -24,6 +24,12 @@ constexpr std::size_t kReservedOcclusionPoints = 250'000;
 
 constexpr double kAway = 0.01;     // [m]: the camera has moved from a view
 constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
+// A steady target: within kSteadyDeg of the previous frame's for
+// kSteadyFrames frames (ViewLoop::retreat); on the way there, only a loss
+// of more than kSteadyLoss of what the camera showed counts.
+constexpr double kSteadyDeg = 10.0;
+constexpr int kSteadyFrames = 10;
+constexpr double kSteadyLoss = 0.5;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -201,6 +207,11 @@ SettingsTable<LoopSettings> make_table() {
          "drives back there too; 0 (off) to 1"},
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
+  t.add({"look_ahead", "bool", format_bool(d.no_free_view.look_ahead), "",
+         "with retreat_drop > 0: the camera holds rather than go on where, on its way to the target, the occluders "
+         "standing still would hide retreat_drop more of the object (as far as it travels before it could stop)"},
+        [](L& l, const std::string& v) { l.no_free_view.look_ahead = parse_bool("look_ahead", v); },
+        [](const L& l) { return format_bool(l.no_free_view.look_ahead); });
   t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
          "no_free_view=most_visible: a view must see this fraction more of the object than the current one, 0 to 1"},
         [](L& l, const std::string& v) {
@@ -271,6 +282,7 @@ void ViewLoop::reset() {
   steady_frames_ = 0;
   release_when_steady_ = false;
   steadiness_ends_holds_ = false;
+  t0_was_clear_ = false;
   last_centroid_.reset();
 }
 
@@ -298,9 +310,6 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eig
   // arrived: what hides t0 was there from the start, like a cage), and
   // again after a hold that steadiness ended (a steady target failed: in
   // a still cage the gaps are steady too).
-  constexpr double kSteadyDeg = 10.0;
-  constexpr int kSteadyFrames = 10;
-  constexpr double kSteadyLoss = 0.5;
   if (target && estimate.status == ViewStatus::Converged) {
     const Eigen::Vector3d direction = (*target - c).normalized();
     const bool near = target_direction_ && direction.dot(*target_direction_) >= std::cos(kSteadyDeg * EIGEN_PI / 180.0);
@@ -311,7 +320,7 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eig
     target_direction_.reset();
   }
   const bool steady = steady_frames_ >= kSteadyFrames;
-  if (estimate.iterations == 0) steadiness_ends_holds_ = true;
+  if (estimate.iterations == 0) steadiness_ends_holds_ = t0_was_clear_ = true;
   if (held_) {
     const bool there = (here - held_->position).norm() <= kAway;
     low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
@@ -358,6 +367,51 @@ std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eig
   release_when_steady_ = !steady && steadiness_ends_holds_;
   low_frames_ = 0;
   return held_->position;
+}
+
+std::optional<Eigen::Vector3d> ViewLoop::look_ahead(const ViewProblem& problem,
+                                                     const Eigen::Vector3d& c,
+                                                     const std::optional<Eigen::Vector3d>& target, double dt,
+                                                     double frame_age) const {
+  const NoFreeViewSettings& s = settings_.no_free_view;
+  if (!s.look_ahead || !(s.retreat_drop > 0.0) || !target || held_) return target;
+  const double r = estimator_.r_sphere;
+  const Eigen::Vector3d from = (*problem.camera - c).normalized();
+  const Eigen::Vector3d to = (*target - c).normalized();
+  const double angle = std::acos(std::clamp(from.dot(to), -1.0, 1.0));
+  if (r * angle <= kAway || !(std::sin(angle) > 1e-9)) return target;  // there, or straight across: no one way
+  // How far the camera may go before a frame shows the loss and it stops:
+  // at the speed limit for the frame's age and one period, then braking.
+  const double v = settings_.safety.max_linear_speed;
+  const double a = settings_.safety.max_linear_accel;
+  const double reach = std::min(r * angle, v * (std::max(frame_age, 0.0) + dt) + v * v / (2.0 * a));
+  // The occluders as they stand: until t0 has been clear, all of them (what
+  // hides the object was there from the start); then only those seen
+  // whose tracks do not move (the others, and what the image border cuts
+  // of them, will not be where they are now).
+  ViewProblem scene = problem;
+  if (t0_was_clear_) {
+    std::vector<Eigen::Vector3d> still;
+    for (const OccluderTrack& t : tracker_.tracks()) {
+      if (is_moving(t, settings_.anticipation.min_speed)) continue;
+      for (Eigen::Index i = 0; i < t.points.cols(); ++i) still.push_back(t.points.col(i));
+    }
+    scene.occluders.resize(3, static_cast<Eigen::Index>(still.size()));
+    for (std::size_t i = 0; i < still.size(); ++i) scene.occluders.col(static_cast<Eigen::Index>(i)) = still[i];
+  }
+  const auto score = [&](const Eigen::Vector3d& direction) {
+    return score_view(scene, c, r, c + r * direction, s.occluder_radius).visible_fraction;
+  };
+  const double now = score(from);
+  double worst = now;
+  constexpr int kSamples = 3;  // points on the way, the last at `reach`
+  for (int k = 1; k <= kSamples; ++k) {
+    const double along = reach / r * k / kSamples;  // angle from `from` on the great circle to `to`
+    worst = std::min(worst, score((std::sin(angle - along) * from + std::sin(along) * to) / std::sin(angle)));
+  }
+  const bool steady = steady_frames_ >= kSteadyFrames;
+  const bool loses = worst < (1.0 - s.retreat_drop) * now && (!steady || worst < kSteadyLoss * now);
+  return loses ? std::optional<Eigen::Vector3d>(c + r * from) : target;  // hold here
 }
 
 std::vector<std::pair<int, Eigen::Vector3d>> ViewLoop::track_positions() const {
@@ -524,7 +578,10 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
       }
     }
     out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate, kept);
-    if (settings_.method == ViewMethod::Estimator && shown) out.target = retreat(*problem, seen, *out.estimate, *shown, dt, out.target);
+    if (settings_.method == ViewMethod::Estimator && shown) {
+      out.target = retreat(*problem, seen, *out.estimate, *shown, dt, out.target);
+      out.target = look_ahead(*problem, out.estimate->centroid, out.target, dt, frame_age);
+    }
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
     last_centroid_ = out.estimate->centroid;

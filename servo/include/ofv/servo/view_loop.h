@@ -192,6 +192,12 @@ class ViewLoop {
     double age = 0.0;  ///< time since [s]
     std::vector<std::pair<int, Eigen::Vector3d>> tracks;  ///< each track's id and position then
   };
+  /// NoFreeViewSettings::look_ahead: `target`, or the camera's own view
+  /// (hold) when the way there hides more of the object.
+  [[nodiscard]] std::optional<Eigen::Vector3d> look_ahead(const ViewProblem& problem,
+                                                          const Eigen::Vector3d& c,
+                                                          const std::optional<Eigen::Vector3d>& target, double dt,
+                                                          double frame_age) const;
   [[nodiscard]] std::vector<std::pair<int, Eigen::Vector3d>> track_positions() const;
   /// This frame's points of the tracks that stand still and stood where
   /// they are when `then` was seen (or were not tracked then): what the
@@ -212,6 +218,7 @@ class ViewLoop {
   int steady_frames_ = 0;              ///< frames in a row it stayed near the previous one
   bool release_when_steady_ = false;   ///< the hold began on the way to a target not yet steady
   bool steadiness_ends_holds_ = false; ///< t0 was clear in some frame since steadiness last ended a hold (or since the start)
+  bool t0_was_clear_ = false;          ///< t0 was clear in some frame since the start
 };
 
 }  // namespace ofv
