@@ -119,17 +119,18 @@ struct NoFreeViewSettings {
   /// back there and stops. 0 = off.
   double retreat_drop = 0.1;
   /// Look-ahead (with retreat_drop > 0, ofv::ViewLoop told what each frame
-  /// shows): the camera does not go on towards its target when, on the way
-  /// (3 points on the great circle, the last as far as it can travel before
-  /// a frame shows a loss and it stops: max_linear_speed x (frame age + one
-  /// period) plus the braking distance), score_view shows retreat_drop less
-  /// of the object than here (on the way to a steady target: half); it
-  /// holds where it is. Scored with the occluders as they stand: every one
-  /// (presumed too) until t0 has been clear (what hides the object was
-  /// there from the start, like a cage), then only the seen ones whose
-  /// tracks do not move (the others will not be where they are now). The
-  /// retreat acts once the camera has lost part of the object; the
-  /// look-ahead keeps it from losing it.
+  /// shows), until t0 has been clear in some frame: the camera does not go
+  /// on towards its target when, on the way (3 points on the great circle,
+  /// the last as far as it can travel before a frame shows a loss and it
+  /// stops: max_linear_speed x (frame age + one period) plus the braking
+  /// distance), score_view with the frame's occluders shows retreat_drop
+  /// less of the object than here (on the way to a steady target: half);
+  /// it holds where it is. Until t0 has been clear, what hides the object
+  /// was there from the start and stands still (a cage): the retreat acts
+  /// once the camera has lost part of the object, the look-ahead keeps it
+  /// from losing it. Once t0 has been clear, what hides the object came in
+  /// and may stand on the way out of a valley (an arm stopped over the
+  /// object), where holding would keep the camera there.
   bool look_ahead = true;
 };
 

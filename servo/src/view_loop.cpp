@@ -208,8 +208,9 @@ SettingsTable<LoopSettings> make_table() {
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
   t.add({"look_ahead", "bool", format_bool(d.no_free_view.look_ahead), "",
-         "with retreat_drop > 0: the camera holds rather than go on where, on its way to the target, the occluders "
-         "standing still would hide retreat_drop more of the object (as far as it travels before it could stop)"},
+         "with retreat_drop > 0, until t0 has been clear (what hides the object was there from the start): the camera "
+         "holds rather than go on where, on its way to the target, the occluders would hide retreat_drop more of the "
+         "object (as far as it travels before it could stop)"},
         [](L& l, const std::string& v) { l.no_free_view.look_ahead = parse_bool("look_ahead", v); },
         [](const L& l) { return format_bool(l.no_free_view.look_ahead); });
   t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
@@ -374,7 +375,11 @@ std::optional<Eigen::Vector3d> ViewLoop::look_ahead(const ViewProblem& problem,
                                                      const std::optional<Eigen::Vector3d>& target, double dt,
                                                      double frame_age) const {
   const NoFreeViewSettings& s = settings_.no_free_view;
-  if (!s.look_ahead || !(s.retreat_drop > 0.0) || !target || held_) return target;
+  // Only until t0 has been clear: what hides the object was there from the
+  // start and stands still (a cage). What came in since may stand on the
+  // way out of the valley the camera is in, where going on beats holding
+  // (an arm that stopped over the object; the retreat still acts on a loss).
+  if (!s.look_ahead || !(s.retreat_drop > 0.0) || !target || held_ || t0_was_clear_) return target;
   const double r = estimator_.r_sphere;
   const Eigen::Vector3d from = (*problem.camera - c).normalized();
   const Eigen::Vector3d to = (*target - c).normalized();
@@ -385,22 +390,8 @@ std::optional<Eigen::Vector3d> ViewLoop::look_ahead(const ViewProblem& problem,
   const double v = settings_.safety.max_linear_speed;
   const double a = settings_.safety.max_linear_accel;
   const double reach = std::min(r * angle, v * (std::max(frame_age, 0.0) + dt) + v * v / (2.0 * a));
-  // The occluders as they stand: until t0 has been clear, all of them (what
-  // hides the object was there from the start); then only those seen
-  // whose tracks do not move (the others, and what the image border cuts
-  // of them, will not be where they are now).
-  ViewProblem scene = problem;
-  if (t0_was_clear_) {
-    std::vector<Eigen::Vector3d> still;
-    for (const OccluderTrack& t : tracker_.tracks()) {
-      if (is_moving(t, settings_.anticipation.min_speed)) continue;
-      for (Eigen::Index i = 0; i < t.points.cols(); ++i) still.push_back(t.points.col(i));
-    }
-    scene.occluders.resize(3, static_cast<Eigen::Index>(still.size()));
-    for (std::size_t i = 0; i < still.size(); ++i) scene.occluders.col(static_cast<Eigen::Index>(i)) = still[i];
-  }
   const auto score = [&](const Eigen::Vector3d& direction) {
-    return score_view(scene, c, r, c + r * direction, s.occluder_radius).visible_fraction;
+    return score_view(problem, c, r, c + r * direction, s.occluder_radius).visible_fraction;
   };
   const double now = score(from);
   double worst = now;

@@ -360,7 +360,7 @@ TEST(ViewLoop, AfterASteadyViewFailedSteadinessNoLongerEndsAHold) {
 // target (`side` rad around the line of sight: 0 = on the way), and
 // look_ahead on or off. The point hides the whole patch from there (every
 // line of sight passes within its 2 cm), none of it from the origin.
-Eigen::Vector3d target_with_a_post(double along, double side, bool look_ahead) {
+Eigen::Vector3d target_with_a_post(double along, double side, bool look_ahead, bool t0_was_clear = false) {
   ViewLoop plain(LoopSettings{});
   const Eigen::Vector3d away = stay(plain, 1);
   const Eigen::Vector3d object(0, 0, 0.5);
@@ -372,6 +372,7 @@ Eigen::Vector3d target_with_a_post(double along, double side, bool look_ahead) {
   LoopSettings settings;
   settings.no_free_view.look_ahead = look_ahead;
   ViewLoop loop(settings);
+  if (t0_was_clear) see_t0_clear(loop);
   const LoopStep s = loop.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, 100.0);
   EXPECT_TRUE(s.target);
   return s.target.value_or(Eigen::Vector3d::Constant(NAN));
@@ -381,12 +382,14 @@ TEST(ViewLoop, ItDoesNotGoWhereItsOwnMotionWouldHideTheObject) {
   // Within what the camera travels before a frame could show the loss and
   // it could stop (0.5 m/s for one period, then 8 m/s^2 of braking: 3.2 cm),
   // the way to the estimator's view passes behind a still occluder: it
-  // holds where it is. Without the look-ahead, or with the occluder off its
-  // way or beyond that reach, it goes.
+  // holds where it is. Without the look-ahead, with the occluder off its
+  // way or beyond that reach, or once t0 has been clear (what hides the
+  // object came in: it may stand on the only way out), it goes.
   EXPECT_LT(target_with_a_post(0.025, 0.0, true).norm(), 1e-9);
   EXPECT_GT(target_with_a_post(0.025, 0.0, false).norm(), 0.05);
   EXPECT_GT(target_with_a_post(0.025, EIGEN_PI / 2, true).norm(), 0.05);
   EXPECT_GT(target_with_a_post(0.07, 0.0, true).norm(), 0.05);
+  EXPECT_GT(target_with_a_post(0.025, 0.0, true, true).norm(), 0.05);
 }
 
 TEST(ViewLoop, SettingsByNameAreValidated) {
