@@ -125,12 +125,15 @@ struct NoFreeViewSettings {
   /// stops: max_linear_speed x (frame age + one period) plus the braking
   /// distance), score_view with the frame's occluders shows retreat_drop
   /// less of the object than here (on the way to a steady target: half);
-  /// it holds where it is. Until t0 has been clear, what hides the object
-  /// was there from the start and stands still (a cage): the retreat acts
-  /// once the camera has lost part of the object, the look-ahead keeps it
-  /// from losing it. Once t0 has been clear, what hides the object came in
-  /// and may stand on the way out of a valley (an arm stopped over the
-  /// object), where holding would keep the camera there.
+  /// it climbs to a nearby view that sees clearly more (most_visible_view)
+  /// if the way there keeps what it sees, else it holds where it is
+  /// (holding alone, it would stay wherever it started). Until t0 has been
+  /// clear, what hides the object was there from the start and stands
+  /// still (a cage): the retreat acts once the camera has lost part of the
+  /// object, the look-ahead keeps it from losing it. Once t0 has been
+  /// clear, what hides the object came in and may stand on the way out of
+  /// a valley (an arm stopped over the object), where holding would keep
+  /// the camera there.
   bool look_ahead = true;
 };
 

@@ -208,9 +208,9 @@ SettingsTable<LoopSettings> make_table() {
         [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
   t.add({"look_ahead", "bool", format_bool(d.no_free_view.look_ahead), "",
-         "with retreat_drop > 0, until t0 has been clear (what hides the object was there from the start): the camera "
-         "holds rather than go on where, on its way to the target, the occluders would hide retreat_drop more of the "
-         "object (as far as it travels before it could stop)"},
+         "with retreat_drop > 0, until t0 has been clear (what hides the object was there from the start): where, on "
+         "its way to the target, the occluders would hide retreat_drop more of the object (as far as it travels before "
+         "it could stop), the camera climbs to a nearby view that sees clearly more, or holds"},
         [](L& l, const std::string& v) { l.no_free_view.look_ahead = parse_bool("look_ahead", v); },
         [](const L& l) { return format_bool(l.no_free_view.look_ahead); });
   t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
@@ -382,27 +382,36 @@ std::optional<Eigen::Vector3d> ViewLoop::look_ahead(const ViewProblem& problem,
   if (!s.look_ahead || !(s.retreat_drop > 0.0) || !target || held_ || t0_was_clear_) return target;
   const double r = estimator_.r_sphere;
   const Eigen::Vector3d from = (*problem.camera - c).normalized();
-  const Eigen::Vector3d to = (*target - c).normalized();
-  const double angle = std::acos(std::clamp(from.dot(to), -1.0, 1.0));
-  if (r * angle <= kAway || !(std::sin(angle) > 1e-9)) return target;  // there, or straight across: no one way
-  // How far the camera may go before a frame shows the loss and it stops:
-  // at the speed limit for the frame's age and one period, then braking.
-  const double v = settings_.safety.max_linear_speed;
-  const double a = settings_.safety.max_linear_accel;
-  const double reach = std::min(r * angle, v * (std::max(frame_age, 0.0) + dt) + v * v / (2.0 * a));
   const auto score = [&](const Eigen::Vector3d& direction) {
     return score_view(problem, c, r, c + r * direction, s.occluder_radius).visible_fraction;
   };
   const double now = score(from);
-  double worst = now;
-  constexpr int kSamples = 3;  // points on the way, the last at `reach`
-  for (int k = 1; k <= kSamples; ++k) {
-    const double along = reach / r * k / kSamples;  // angle from `from` on the great circle to `to`
-    worst = std::min(worst, score((std::sin(angle - along) * from + std::sin(along) * to) / std::sin(angle)));
-  }
+  // How far the camera may go before a frame shows the loss and it stops:
+  // at the speed limit for the frame's age and one period, then braking.
+  const double v = settings_.safety.max_linear_speed;
+  const double a = settings_.safety.max_linear_accel;
+  const double reach = v * (std::max(frame_age, 0.0) + dt) + v * v / (2.0 * a);
   const bool steady = steady_frames_ >= kSteadyFrames;
-  const bool loses = worst < (1.0 - s.retreat_drop) * now && (!steady || worst < kSteadyLoss * now);
-  return loses ? std::optional<Eigen::Vector3d>(c + r * from) : target;  // hold here
+  // Whether the way to `goal` (3 points on the great circle, the last at
+  // `reach`) loses what the look-ahead counts.
+  const auto loses_on_the_way = [&](const Eigen::Vector3d& goal) {
+    const Eigen::Vector3d to = (goal - c).normalized();
+    const double angle = std::acos(std::clamp(from.dot(to), -1.0, 1.0));
+    if (r * angle <= kAway || !(std::sin(angle) > 1e-9)) return false;  // there, or straight across: no one way
+    double worst = now;
+    constexpr int kSamples = 3;
+    for (int k = 1; k <= kSamples; ++k) {
+      const double along = std::min(angle, reach / r) * k / kSamples;  // from `from` towards `to`
+      worst = std::min(worst, score((std::sin(angle - along) * from + std::sin(along) * to) / std::sin(angle)));
+    }
+    return worst < (1.0 - s.retreat_drop) * now && (!steady || worst < kSteadyLoss * now);
+  };
+  if (!loses_on_the_way(*target)) return target;
+  // Climb to a nearby view that sees clearly more, if the way there keeps
+  // what the camera sees (holding alone, it would stay wherever it
+  // started); else hold.
+  const Eigen::Vector3d climb = most_visible_view(problem, c, r, *problem.camera, {}, s).view;
+  return loses_on_the_way(climb) ? c + r * from : climb;
 }
 
 std::vector<std::pair<int, Eigen::Vector3d>> ViewLoop::track_positions() const {
