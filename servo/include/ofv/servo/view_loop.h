@@ -192,8 +192,9 @@ class ViewLoop {
     double age = 0.0;  ///< time since [s]
     std::vector<std::pair<int, Eigen::Vector3d>> tracks;  ///< each track's id and position then
   };
-  /// NoFreeViewSettings::look_ahead: `target`, or the camera's own view
-  /// (hold) when the way there hides more of the object.
+  /// NoFreeViewSettings::look_ahead: `target`, or when the way there hides
+  /// more of the object, a nearby view that sees more (most_visible_view)
+  /// or the camera's own view (hold).
   [[nodiscard]] std::optional<Eigen::Vector3d> look_ahead(const ViewProblem& problem,
                                                           const Eigen::Vector3d& c,
                                                           const std::optional<Eigen::Vector3d>& target, double dt,
