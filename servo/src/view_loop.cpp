@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -285,6 +286,7 @@ void ViewLoop::reset() {
   steadiness_ends_holds_ = false;
   t0_was_clear_ = false;
   last_centroid_.reset();
+  first_positions_.clear();
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eigen::Index seen,
@@ -421,14 +423,16 @@ std::vector<std::pair<int, Eigen::Vector3d>> ViewLoop::track_positions() const {
 }
 
 Eigen::Matrix3Xd ViewLoop::revealed_still(const SeenView& then) const {
-  // Farther than this since `then`, a track that stands still now came
-  // there (an arm that arrived and stopped): not revealed by the camera.
+  // Farther than this since `then` (or, not tracked then, since it was
+  // first seen), a track that stands still now came there (an arm that
+  // arrived and stopped): not revealed by the camera.
   constexpr double kMovedSince = 0.05;  // [m]
   std::vector<OccluderTrack> still;
   for (const OccluderTrack& t : tracker_.tracks()) {
     if (!is_still(t, settings_.anticipation.min_speed)) continue;
     const auto was = std::find_if(then.tracks.begin(), then.tracks.end(), [&](const auto& p) { return p.first == t.id; });
-    if (was == then.tracks.end() || (t.position - was->second).norm() <= kMovedSince) still.push_back(t);
+    const Eigen::Vector3d& since = was != then.tracks.end() ? was->second : first_positions_.at(t.id);
+    if ((t.position - since).norm() <= kMovedSince) still.push_back(t);
   }
   return still_occluders(still, settings_.anticipation.min_speed);
 }
@@ -530,6 +534,12 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
   } else {
     out.tracks = tracker_.coast(dt);
   }
+  std::map<int, Eigen::Vector3d> first;
+  for (const OccluderTrack& t : out.tracks) {
+    const auto known = first_positions_.find(t.id);
+    first.emplace(t.id, known != first_positions_.end() ? known->second : t.position);
+  }
+  first_positions_ = std::move(first);
   if (out.estimate) {
     switch (out.estimate->status) {
       case ViewStatus::Converged: out.status = StepStatus::Converged; break;

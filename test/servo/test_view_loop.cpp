@@ -202,14 +202,18 @@ vpHomogeneousMatrix at(const Eigen::Vector3d& p) { return vpHomogeneousMatrix(vp
 // to the estimator's view (showing 40) while a cluster that stood aside
 // since the start moves in between (0.6 m/s) and stops there, in front of
 // the camera's way more than in front of the origin. Returns how many of
-// the frames after it stopped had the origin as target.
-int retreats_after_an_arrival() {
+// the frames after it stopped had the origin as target. `seen_before`:
+// the cluster is seen while the camera is at the origin, else it comes
+// into view when the camera leaves.
+int retreats_after_an_arrival(bool seen_before = true) {
   const double dt = 1.0 / 30.0;
   ViewLoop loop(LoopSettings{});
-  const auto frame = [&](const Eigen::Vector3d& camera, const Eigen::Vector3d& cluster, double shown) {
+  const auto frame = [&](const Eigen::Vector3d& camera, const std::optional<Eigen::Vector3d>& cluster, double shown) {
     ViewProblem p = occluded_patch();
-    p.occluders.conservativeResize(3, 9 + 49);
-    for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = cluster + 0.006 * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
+    if (cluster) {
+      p.occluders.conservativeResize(3, 9 + 49);
+      for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = *cluster + 0.006 * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
+    }
     return loop.step(p, at(camera), dt, 0.0, shown);
   };
   Eigen::Vector3d away = stay(loop, 1).normalized();
@@ -217,7 +221,9 @@ int retreats_after_an_arrival() {
   // 4.8 cm beside the origin's.
   const Eigen::Vector3d stop = 0.6 * (0.08 * away) + Eigen::Vector3d(0, 0, 0.2);
   const Eigen::Vector3d aside = stop - 0.1 * away;
-  for (int k = 0; k < 8; ++k) (void)frame(Eigen::Vector3d::Zero(), aside, 100.0);
+  for (int k = 0; k < 8; ++k) {
+    (void)frame(Eigen::Vector3d::Zero(), seen_before ? std::optional<Eigen::Vector3d>(aside) : std::nullopt, 100.0);
+  }
   Eigen::Vector3d camera = Eigen::Vector3d::Zero();
   Eigen::Vector3d cluster = aside;
   int back = 0;
@@ -238,6 +244,9 @@ TEST(ViewLoop, AnOccluderThatArrivedAndStoppedIsNoReasonToRetreat) {
   // motion (it moved since the origin showed the most), so the camera keeps
   // its way instead of going back.
   EXPECT_EQ(retreats_after_an_arrival(), 0);
+  // Nor when it came into view only after the origin showed the most (an
+  // arm entering the image): it moved since it was first seen.
+  EXPECT_EQ(retreats_after_an_arrival(/*seen_before=*/false), 0);
 }
 
 TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {

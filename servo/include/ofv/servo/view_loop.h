@@ -34,6 +34,7 @@
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -201,8 +202,8 @@ class ViewLoop {
                                                           double frame_age) const;
   [[nodiscard]] std::vector<std::pair<int, Eigen::Vector3d>> track_positions() const;
   /// This frame's points of the tracks that stand still and stood where
-  /// they are when `then` was seen (or were not tracked then): what the
-  /// camera's motion may have revealed.
+  /// they are when `then` was seen (or, not tracked then, where they were
+  /// first seen): what the camera's motion may have revealed.
   [[nodiscard]] Eigen::Matrix3Xd revealed_still(const SeenView& then) const;
 
   LoopSettings settings_;
@@ -220,6 +221,7 @@ class ViewLoop {
   bool release_when_steady_ = false;   ///< the hold began on the way to a target not yet steady
   bool steadiness_ends_holds_ = false; ///< t0 was clear in some frame since steadiness last ended a hold (or since the start)
   bool t0_was_clear_ = false;          ///< t0 was clear in some frame since the start
+  std::map<int, Eigen::Vector3d> first_positions_;  ///< each current track's position when first seen
 };
 
 }  // namespace ofv
