@@ -286,7 +286,7 @@ void ViewLoop::reset() {
   steadiness_ends_holds_ = false;
   t0_was_clear_ = false;
   last_centroid_.reset();
-  first_positions_.clear();
+  track_history_.clear();
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eigen::Index seen,
@@ -423,18 +423,38 @@ std::vector<std::pair<int, Eigen::Vector3d>> ViewLoop::track_positions() const {
 }
 
 Eigen::Matrix3Xd ViewLoop::revealed_still(const SeenView& then) const {
-  // Farther than this since `then` (or, not tracked then, since it was
-  // first seen), a track that stands still now came there (an arm that
-  // arrived and stopped): not revealed by the camera.
+  // A track that stands still now came there, and was not revealed by the
+  // camera, when it moved farther than this since `then` (or, not tracked
+  // then, since it was first seen), or when it came into view moving (an
+  // arm that arrived and stopped).
   constexpr double kMovedSince = 0.05;  // [m]
   std::vector<OccluderTrack> still;
   for (const OccluderTrack& t : tracker_.tracks()) {
     if (!is_still(t, settings_.anticipation.min_speed)) continue;
+    const TrackHistory& history = track_history_.at(t.id);
     const auto was = std::find_if(then.tracks.begin(), then.tracks.end(), [&](const auto& p) { return p.first == t.id; });
-    const Eigen::Vector3d& since = was != then.tracks.end() ? was->second : first_positions_.at(t.id);
-    if ((t.position - since).norm() <= kMovedSince) still.push_back(t);
+    const Eigen::Vector3d& since = was != then.tracks.end() ? was->second : history.first_position;
+    if (!history.arrived && (t.position - since).norm() <= kMovedSince) still.push_back(t);
   }
   return still_occluders(still, settings_.anticipation.min_speed);
+}
+
+void ViewLoop::remember_tracks(const std::vector<OccluderTrack>& tracks, double dt) {
+  // Moving within this time of being first seen, a track came into view
+  // moving: it arrived, the camera did not reveal it.
+  constexpr double kArrival = 0.3;  // [s]
+  std::map<int, TrackHistory> history;
+  for (const OccluderTrack& t : tracks) {
+    const auto known = track_history_.find(t.id);
+    TrackHistory h{t.position};
+    if (known != track_history_.end()) {
+      h = known->second;
+      h.age += dt;
+    }
+    h.arrived = h.arrived || (h.age <= kArrival && is_moving(t, settings_.anticipation.min_speed));
+    history.emplace(t.id, h);
+  }
+  track_history_ = std::move(history);
 }
 
 std::optional<Eigen::Vector3d> ViewLoop::way_back(const Eigen::Vector3d& here, double dt) {
@@ -524,7 +544,11 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     out.estimate = estimate_view(*problem, estimator_);
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
   }
-  if (!(std::isfinite(dt) && dt > 0.0)) tracker_.reset();  // no time base: start the tracks again
+  const bool timed = std::isfinite(dt) && dt > 0.0;
+  if (!timed) {  // no time base: start the tracks again
+    tracker_.reset();
+    track_history_.clear();
+  }
   // The occluders seen in the frame: those presumed (untracked) come last.
   const Eigen::Index seen =
       problem ? problem->occluders.cols() - std::clamp<Eigen::Index>(untracked, 0, problem->occluders.cols()) : 0;
@@ -534,12 +558,7 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
   } else {
     out.tracks = tracker_.coast(dt);
   }
-  std::map<int, Eigen::Vector3d> first;
-  for (const OccluderTrack& t : out.tracks) {
-    const auto known = first_positions_.find(t.id);
-    first.emplace(t.id, known != first_positions_.end() ? known->second : t.position);
-  }
-  first_positions_ = std::move(first);
+  remember_tracks(out.tracks, timed ? dt : 0.0);
   if (out.estimate) {
     switch (out.estimate->status) {
       case ViewStatus::Converged: out.status = StepStatus::Converged; break;

@@ -204,8 +204,8 @@ vpHomogeneousMatrix at(const Eigen::Vector3d& p) { return vpHomogeneousMatrix(vp
 // the camera's way more than in front of the origin. Returns how many of
 // the frames after it stopped had the origin as target. `seen_before`:
 // the cluster is seen while the camera is at the origin, else it comes
-// into view when the camera leaves.
-int retreats_after_an_arrival(bool seen_before = true) {
+// into view when the camera leaves, `way` before where it stops.
+int retreats_after_an_arrival(bool seen_before = true, double way = 0.1) {
   const double dt = 1.0 / 30.0;
   ViewLoop loop(LoopSettings{});
   const auto frame = [&](const Eigen::Vector3d& camera, const std::optional<Eigen::Vector3d>& cluster, double shown) {
@@ -220,7 +220,7 @@ int retreats_after_an_arrival(bool seen_before = true) {
   // On the line of sight from where the camera stops (8 cm along `away`),
   // 4.8 cm beside the origin's.
   const Eigen::Vector3d stop = 0.6 * (0.08 * away) + Eigen::Vector3d(0, 0, 0.2);
-  const Eigen::Vector3d aside = stop - 0.1 * away;
+  const Eigen::Vector3d aside = stop - way * away;
   for (int k = 0; k < 8; ++k) {
     (void)frame(Eigen::Vector3d::Zero(), seen_before ? std::optional<Eigen::Vector3d>(aside) : std::nullopt, 100.0);
   }
@@ -245,8 +245,10 @@ TEST(ViewLoop, AnOccluderThatArrivedAndStoppedIsNoReasonToRetreat) {
   // its way instead of going back.
   EXPECT_EQ(retreats_after_an_arrival(), 0);
   // Nor when it came into view only after the origin showed the most (an
-  // arm entering the image): it moved since it was first seen.
+  // arm entering the image): it moved since it was first seen, or it was
+  // moving when it came into view, even if it stopped within 5 cm.
   EXPECT_EQ(retreats_after_an_arrival(/*seen_before=*/false), 0);
+  EXPECT_EQ(retreats_after_an_arrival(/*seen_before=*/false, /*way=*/0.04), 0);
 }
 
 TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {

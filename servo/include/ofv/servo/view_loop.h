@@ -201,9 +201,18 @@ class ViewLoop {
                                                           const std::optional<Eigen::Vector3d>& target, double dt,
                                                           double frame_age) const;
   [[nodiscard]] std::vector<std::pair<int, Eigen::Vector3d>> track_positions() const;
-  /// This frame's points of the tracks that stand still and stood where
-  /// they are when `then` was seen (or, not tracked then, where they were
-  /// first seen): what the camera's motion may have revealed.
+  /// What the loop keeps of an occluder track since it was first seen.
+  struct TrackHistory {
+    Eigen::Vector3d first_position;
+    double age = 0.0;      ///< time since first seen [s]
+    bool arrived = false;  ///< it moved soon after it was first seen: it came into view moving
+  };
+  /// Updates track_history_ with this frame's tracks.
+  void remember_tracks(const std::vector<OccluderTrack>& tracks, double dt);
+  /// This frame's points of the tracks that stand still, did not arrive
+  /// moving, and stood where they are when `then` was seen (or, not
+  /// tracked then, where they were first seen): what the camera's motion
+  /// may have revealed.
   [[nodiscard]] Eigen::Matrix3Xd revealed_still(const SeenView& then) const;
 
   LoopSettings settings_;
@@ -221,7 +230,7 @@ class ViewLoop {
   bool release_when_steady_ = false;   ///< the hold began on the way to a target not yet steady
   bool steadiness_ends_holds_ = false; ///< t0 was clear in some frame since steadiness last ended a hold (or since the start)
   bool t0_was_clear_ = false;          ///< t0 was clear in some frame since the start
-  std::map<int, Eigen::Vector3d> first_positions_;  ///< each current track's position when first seen
+  std::map<int, TrackHistory> track_history_;  ///< of each current occluder track, by id
 };
 
 }  // namespace ofv
