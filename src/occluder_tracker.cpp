@@ -203,6 +203,62 @@ std::optional<Eigen::Vector3d> wide_plane_normal(const Eigen::Matrix3Xd& points,
   return Eigen::Vector3d(eig.eigenvectors().col(0));
 }
 
+// A wide plane (a table) and what touches it or comes within
+// `link_distance` of it (a hand reaching down to it, an arm sweeping over
+// it) make one cluster, and a wide plane's motion is measured only along
+// its normal: the hand would be taken as still. Such a cluster is cut into
+// the plane and the rest. The plane: a least-squares plane refitted three
+// times to the points within `kPlaneBand` of the last (the plane has most
+// of the points, so the first fit is near it); it must be a wide plane
+// (wide_plane_normal) and hold kPlaneShare of the points. The rest is
+// clustered again; parts of fewer than kMinPart points (a plane's ragged
+// edge) stay with the plane.
+void split_planes(std::vector<std::vector<int>>& clusters, const Eigen::Matrix3Xd& points, double link_distance) {
+  constexpr std::size_t kMinCluster = 30;
+  constexpr double kPlaneShare = 0.6;
+  constexpr std::size_t kMinPart = 3;
+  const double band = 0.3 * link_distance;
+  const std::size_t n_clusters = clusters.size();
+  for (std::size_t c = 0; c < n_clusters; ++c) {
+    std::vector<int>& cluster = clusters[c];
+    if (cluster.size() < kMinCluster) continue;
+    std::vector<int> inside = cluster;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int round = 0; round < 4 && inside.size() >= 3; ++round) {
+      const Eigen::Matrix3Xd part = points(Eigen::all, inside);
+      mean = part.rowwise().mean();
+      const Eigen::Matrix3Xd centred = part.colwise() - mean;
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred * centred.transpose());
+      normal = eig.eigenvectors().col(0);
+      inside.clear();
+      for (const int i : cluster) {
+        if (std::abs(normal.dot(points.col(i) - mean)) <= band) inside.push_back(i);
+      }
+    }
+    if (static_cast<double>(inside.size()) < kPlaneShare * static_cast<double>(cluster.size()) ||
+        inside.size() == cluster.size() || !wide_plane_normal(points(Eigen::all, inside), 0.5 * link_distance)) {
+      continue;
+    }
+    std::vector<int> rest;
+    std::set_difference(cluster.begin(), cluster.end(), inside.begin(), inside.end(), std::back_inserter(rest));
+    const Eigen::Matrix3Xd rest_points = points(Eigen::all, rest);
+    std::vector<std::vector<int>> parts;
+    for (const std::vector<int>& part : cluster_points(rest_points, link_distance)) {
+      if (part.size() < kMinPart) {
+        for (const int k : part) inside.push_back(rest[static_cast<std::size_t>(k)]);
+        continue;
+      }
+      parts.emplace_back();
+      for (const int k : part) parts.back().push_back(rest[static_cast<std::size_t>(k)]);
+    }
+    if (parts.empty()) continue;
+    std::sort(inside.begin(), inside.end());
+    cluster = std::move(inside);
+    for (auto& part : parts) clusters.push_back(std::move(part));
+  }
+}
+
 // Clusters that join occluders followed apart until now (a hand reaching the
 // table, two hands touching) are cut back into them, each part then owned by
 // its track. Each point of such a cluster goes to the track of the nearest
@@ -485,6 +541,7 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
   started_ = true;
 
   std::vector<std::vector<int>> clusters = cluster_points(occluders, settings_.link_distance);
+  split_planes(clusters, occluders, settings_.link_distance);
   std::vector<int> owner;
   split_merged(tracks_, period, settings_.link_distance, clusters, occluders, owner);
   std::vector<Eigen::Vector3d> centroids;

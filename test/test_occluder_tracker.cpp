@@ -166,6 +166,29 @@ TEST(OccluderTracker, AHandThatReachesTheTableKeepsItsTrackAndVelocity) {
   EXPECT_EQ(still.points.cols(), 21 * 21);
 }
 
+TEST(OccluderTracker, AHandSeenOnlyAgainstTheTableHasItsOwnTrack) {
+  // A hand slides at 0.6 m/s 3 cm above a still table from the first frame
+  // on: single linkage never sees them apart. The wide plane is cut from
+  // what lies off it: the hand has its own track and velocity (measured
+  // with the table, only along the table's normal, it was still), the
+  // table stays still.
+  Eigen::Matrix3Xd table(3, 21 * 21);
+  for (int k = 0; k < 21 * 21; ++k) table.col(k) = Eigen::Vector3d(-0.2 + 0.02 * (k % 21), 0.0, 0.2 + 0.02 * (k / 21));
+  const double dt = 1.0 / 30.0;
+  const double speed = 0.6;
+  OccluderTracker tracker;
+  for (int k = 0; k < 15; ++k) {
+    const auto& tracks = tracker.update(join(table, block({-0.2 + speed * k * dt, -0.09, 0.4})), dt);
+    ASSERT_EQ(tracks.size(), 2U) << "frame " << k;
+  }
+  const OccluderTrack& still = tracker.tracks()[0];
+  const OccluderTrack& hand = tracker.tracks()[1];
+  EXPECT_EQ(still.points.cols(), 21 * 21);
+  EXPECT_EQ(hand.points.cols(), 32);
+  EXPECT_LT((hand.velocity - Eigen::Vector3d(speed, 0, 0)).norm(), 0.03) << hand.velocity.transpose();
+  EXPECT_LT(still.velocity.norm(), 0.01) << still.velocity.transpose();
+}
+
 // A capsule's camera-facing half, axis along x, radius 3 cm, `length` long,
 // its centre at `centre`; points about 1.5 cm apart.
 Eigen::Matrix3Xd capsule_along_x(const Eigen::Vector3d& centre, double length) {

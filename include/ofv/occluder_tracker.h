@@ -6,13 +6,20 @@
  * Each frame the occluder points (ViewProblem::occluders, from perception or
  * from the simulator's ground truth) are cut into clusters: single linkage,
  * two points in one cluster when a chain of points less than `link_distance`
- * apart joins them (a hand, an arm, a tool). Each cluster's centroid is a
- * measurement of one track. A cluster that joins occluders followed apart
- * until now (a hand reaching the table, two hands touching) is cut back
- * into them: each of its points goes to the track whose prediction (last
- * frame's points moved by the track's velocity) is nearest, when at least
- * two tracks each have 3 of the cluster's points within `link_distance` of
- * their prediction; each part is that track's measurement.
+ * apart joins them (a hand, an arm, a tool). A cluster of 30 points or
+ * more that is mostly a wide plane (a table) is cut into the plane and what
+ * lies more than 0.3 x `link_distance` off it (a hand seen only against
+ * the table, an arm sweeping over it), since a wide plane's motion is
+ * measured only along its normal (below): the plane is a least-squares
+ * plane refitted three times to the points near the last one, and it must
+ * hold 60 % of the points; parts of fewer than 3 points stay with it.
+ * Each cluster's centroid is a measurement of one track. A cluster that
+ * joins occluders followed apart until now (a hand reaching the table, two
+ * hands touching) is cut back into them: each of its points goes to the
+ * track whose prediction (last frame's points moved by the track's
+ * velocity) is nearest, when at least two tracks each have 3 of the
+ * cluster's points within `link_distance` of their prediction; each part
+ * is that track's measurement.
  *
  * A track is a constant-velocity Kalman filter on its position: state
  * (position, velocity), white-noise acceleration of spectral density
