@@ -303,6 +303,34 @@ TEST(OccluderTracker, StillOccludersAreTheConfirmedSlowTracksSeenThisFrame) {
   EXPECT_EQ(still_occluders({moving}, 1.0).cols(), moving.points.cols());
 }
 
+TEST(OccluderTracker, HostilePointsLeaveTheOthersTracked) {
+  // A table with a hand just above it, and among them points that are not
+  // finite, repeated, or far beyond any cell index: the table and the hand
+  // are still tracked apart, the table still, every finite track finite.
+  Eigen::Matrix3Xd table(3, 21 * 21);
+  for (int k = 0; k < 21 * 21; ++k) table.col(k) = Eigen::Vector3d(-0.2 + 0.02 * (k % 21), 0.0, 0.2 + 0.02 * (k / 21));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  Eigen::Matrix3Xd odd(3, 6);
+  odd << nan, 1e200, 1e200, 0.0, -inf, 1e200,  //
+      0.0, 0.0, 0.0, nan, 0.0, 1e200,          //
+      0.0, 0.0, 0.0, 0.4, 0.0, -1e200;
+  const double dt = 1.0 / 30.0;
+  OccluderTracker tracker;
+  for (int k = 0; k < 6; ++k) {
+    const Eigen::Matrix3Xd frame = join(join(table, block({-0.2 + 0.02 * k, -0.09, 0.4})), join(odd, table.leftCols(30)));
+    (void)tracker.update(frame, dt);
+  }
+  int near = 0;
+  for (const OccluderTrack& t : tracker.tracks()) {
+    if (t.position.norm() > 1.0) continue;  // the far points' own tracks
+    ++near;
+    EXPECT_TRUE(t.position.allFinite() && t.velocity.allFinite());
+  }
+  EXPECT_EQ(near, 2);
+  EXPECT_LT(tracker.tracks()[0].velocity.norm(), 0.01) << tracker.tracks()[0].velocity.transpose();
+}
+
 TEST(OccluderTracker, SettingsAndPeriodsAreValidated) {
   TrackerSettings s;
   s.link_distance = 0.0;
