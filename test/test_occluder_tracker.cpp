@@ -143,50 +143,51 @@ TEST(OccluderTracker, TwoOccludersKeepTheirTracksAndALostOneIsDropped) {
   EXPECT_EQ(tracker.tracks()[0].id, 0);
 }
 
-TEST(OccluderTracker, AHandThatReachesTheTableKeepsItsTrackAndVelocity) {
-  // A hand slides at 0.6 m/s over a still table, 4 cm above it: from the
-  // 12th frame on, single linkage joins them into one cluster. The cluster
-  // is cut back between the two tracks: the hand keeps its id and velocity,
-  // the table stays still (one cluster would move at neither speed).
+// A still table top in the plane y = 0: 21 x 21 points 2 cm apart.
+Eigen::Matrix3Xd table_top() {
   Eigen::Matrix3Xd table(3, 21 * 21);
   for (int k = 0; k < 21 * 21; ++k) table.col(k) = Eigen::Vector3d(-0.2 + 0.02 * (k % 21), 0.0, 0.2 + 0.02 * (k / 21));
+  return table;
+}
+
+// A hand (a block of 32 points) sliding at 0.6 m/s along x from x = `from`,
+// `above` over the table top, for `frames` frames: the hand and the table
+// are two tracks every frame; at the end the hand, whose track began
+// first when `hand_first`, has its own velocity, the table none.
+void expect_hand_and_table(double from, double above, int frames, bool hand_first) {
+  const Eigen::Matrix3Xd table = table_top();
   const double dt = 1.0 / 30.0;
   const double speed = 0.6;
   OccluderTracker tracker;
-  for (int k = 0; k < 30; ++k) {
-    const auto& tracks = tracker.update(join(block({-0.5 + speed * k * dt, -0.1, 0.4}), table), dt);
+  for (int k = 0; k < frames; ++k) {
+    const Eigen::Matrix3Xd hand = block({from + speed * k * dt, -above - 0.06, 0.4});
+    const auto& tracks = tracker.update(hand_first ? join(hand, table) : join(table, hand), dt);
     ASSERT_EQ(tracks.size(), 2U) << "frame " << k;
-    EXPECT_EQ(tracks[0].points.cols(), 32) << "frame " << k;
+    EXPECT_EQ(tracks[hand_first ? 0 : 1].points.cols(), 32) << "frame " << k;
   }
-  const OccluderTrack& hand = tracker.tracks()[0];
-  const OccluderTrack& still = tracker.tracks()[1];
-  EXPECT_EQ(hand.id, 0);
+  const OccluderTrack& hand = tracker.tracks()[hand_first ? 0 : 1];
+  const OccluderTrack& still = tracker.tracks()[hand_first ? 1 : 0];
+  EXPECT_EQ(hand.id, hand_first ? 0 : 1);
   EXPECT_LT((hand.velocity - Eigen::Vector3d(speed, 0, 0)).norm(), 0.03) << hand.velocity.transpose();
   EXPECT_LT(still.velocity.norm(), 0.01) << still.velocity.transpose();
   EXPECT_EQ(still.points.cols(), 21 * 21);
 }
 
+TEST(OccluderTracker, AHandThatReachesTheTableKeepsItsTrackAndVelocity) {
+  // A hand slides over a still table, 4 cm above it: from the 12th frame
+  // on, single linkage joins them into one cluster. The cluster is cut
+  // back between the two tracks: the hand keeps its id and velocity, the
+  // table stays still (one cluster would move at neither speed).
+  expect_hand_and_table(-0.5, 0.04, 30, /*hand_first=*/true);
+}
+
 TEST(OccluderTracker, AHandSeenOnlyAgainstTheTableHasItsOwnTrack) {
-  // A hand slides at 0.6 m/s 3 cm above a still table from the first frame
-  // on: single linkage never sees them apart. The wide plane is cut from
-  // what lies off it: the hand has its own track and velocity (measured
-  // with the table, only along the table's normal, it was still), the
-  // table stays still.
-  Eigen::Matrix3Xd table(3, 21 * 21);
-  for (int k = 0; k < 21 * 21; ++k) table.col(k) = Eigen::Vector3d(-0.2 + 0.02 * (k % 21), 0.0, 0.2 + 0.02 * (k / 21));
-  const double dt = 1.0 / 30.0;
-  const double speed = 0.6;
-  OccluderTracker tracker;
-  for (int k = 0; k < 15; ++k) {
-    const auto& tracks = tracker.update(join(table, block({-0.2 + speed * k * dt, -0.09, 0.4})), dt);
-    ASSERT_EQ(tracks.size(), 2U) << "frame " << k;
-  }
-  const OccluderTrack& still = tracker.tracks()[0];
-  const OccluderTrack& hand = tracker.tracks()[1];
-  EXPECT_EQ(still.points.cols(), 21 * 21);
-  EXPECT_EQ(hand.points.cols(), 32);
-  EXPECT_LT((hand.velocity - Eigen::Vector3d(speed, 0, 0)).norm(), 0.03) << hand.velocity.transpose();
-  EXPECT_LT(still.velocity.norm(), 0.01) << still.velocity.transpose();
+  // A hand slides 3 cm above a still table from the first frame on: single
+  // linkage never sees them apart. The wide plane is cut from what lies
+  // off it: the hand has its own track and velocity (measured with the
+  // table, only along the table's normal, it was still), the table stays
+  // still.
+  expect_hand_and_table(-0.2, 0.03, 15, /*hand_first=*/false);
 }
 
 // A capsule's camera-facing half, axis along x, radius 3 cm, `length` long,
@@ -307,8 +308,7 @@ TEST(OccluderTracker, HostilePointsLeaveTheOthersTracked) {
   // A table with a hand just above it, and among them points that are not
   // finite, repeated, or far beyond any cell index: the table and the hand
   // are still tracked apart, the table still, every finite track finite.
-  Eigen::Matrix3Xd table(3, 21 * 21);
-  for (int k = 0; k < 21 * 21; ++k) table.col(k) = Eigen::Vector3d(-0.2 + 0.02 * (k % 21), 0.0, 0.2 + 0.02 * (k / 21));
+  const Eigen::Matrix3Xd table = table_top();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   Eigen::Matrix3Xd odd(3, 6);
