@@ -208,8 +208,8 @@ std::optional<Eigen::Vector3d> wide_plane_normal(const Eigen::Matrix3Xd& points,
 // it) make one cluster, and a wide plane's motion is measured only along
 // its normal: the hand would be taken as still. Such a cluster is cut into
 // the plane and the rest. The plane: a least-squares plane refitted three
-// times to the points within `kPlaneBand` of the last (the plane has most
-// of the points, so the first fit is near it); it must be a wide plane
+// times to the points within `band` of the last (the plane has most of
+// the points, so the first fit is near it); it must be a wide plane
 // (wide_plane_normal) and hold kPlaneShare of the points. The rest is
 // clustered again; parts of fewer than kMinPart points (a plane's ragged
 // edge) stay with the plane.
@@ -223,14 +223,12 @@ void split_planes(std::vector<std::vector<int>>& clusters, const Eigen::Matrix3X
     std::vector<int>& cluster = clusters[c];
     if (cluster.size() < kMinCluster) continue;
     std::vector<int> inside = cluster;
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (int round = 0; round < 4 && inside.size() >= 3; ++round) {
       const Eigen::Matrix3Xd part = points(Eigen::all, inside);
-      mean = part.rowwise().mean();
+      const Eigen::Vector3d mean = part.rowwise().mean();
       const Eigen::Matrix3Xd centred = part.colwise() - mean;
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred * centred.transpose());
-      normal = eig.eigenvectors().col(0);
+      const Eigen::Vector3d normal = eig.eigenvectors().col(0);
       inside.clear();
       for (const int i : cluster) {
         if (std::abs(normal.dot(points.col(i) - mean)) <= band) inside.push_back(i);
