@@ -595,17 +595,18 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     // the centroid's offset from its prediction stands for the position's.
     const Eigen::Matrix3Xd now = occluders(Eigen::all, clusters[c]);
     std::optional<Eigen::Vector3d> moved;
+    std::optional<Eigen::Vector3d> plane;
     bool registered = true;
     if (track.points.cols() > 0) {
       // A wide plane registers from no motion alone: only the motion along
       // its normal counts.
       const Eigen::Vector3d centroid_shift = centroids[c] - (track.centroid - period * track.velocity);
-      const auto normal = wide_plane_normal(now, 0.5 * settings_.link_distance);
+      plane = wide_plane_normal(now, 0.5 * settings_.link_distance);
       std::vector<Eigen::Vector3d> starts{Eigen::Vector3d::Zero()};
-      if (!normal) starts.insert(starts.end(), {period * track.velocity, centroid_shift});
+      if (!plane) starts.insert(starts.end(), {period * track.velocity, centroid_shift});
       moved = track_motion(track.points, now, starts, settings_.link_distance);
       registered = moved.has_value();
-      if (moved && normal) moved = normal->dot(*moved) * *normal;
+      if (moved && plane) moved = plane->dot(*moved) * *plane;
     }
     if (!registered) {
       // The shapes do not overlap either way (the occluder turned, or the
@@ -630,6 +631,10 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     const Eigen::Matrix2d i_kh = Eigen::Matrix2d::Identity() - gain * Eigen::RowVector2d(1.0, 0.0);
     track.covariance = i_kh * track.covariance;
     track.covariance = 0.5 * (track.covariance + track.covariance.transpose()).eval();
+    // A wide plane's motion within itself is not seen: none, not what the
+    // track had before it was one (a piece of table whose part in view
+    // changed while it was small, then joined by the rest of the table).
+    if (plane) track.velocity = plane->dot(track.velocity) * *plane;
     track.points = now;
     ++track.hits;
     track.misses = 0;

@@ -35,7 +35,8 @@
  * best fit wins, and among fits equally good the smallest motion: what the
  * shape cannot show moving (a capsule along its axis, ends unseen) is taken
  * as still. A wide plane (a table) is measured along its normal only (the
- * aperture problem). When too few of the cluster's points find the
+ * aperture problem), and its velocity within itself is none, whatever the
+ * track had before it was one. When too few of the cluster's points find the
  * previous ones (the part seen grew), the previous points are registered
  * onto the cluster's; when neither registers, the track starts again where
  * the cluster is, with its id. The three axes are independent with the same
