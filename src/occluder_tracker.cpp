@@ -257,6 +257,35 @@ void split_planes(std::vector<std::vector<int>>& clusters, const Eigen::Matrix3X
   }
 }
 
+// The normal of each cluster whose motion is measured along it only: a
+// wide plane (wide_plane_normal), or a piece of one, all of whose points
+// lie within `band` of a wide plane of this frame (a table seen in pieces
+// past the object, whose part in view changes as the camera moves: small,
+// it would otherwise take that change for motion within the plane).
+std::vector<std::optional<Eigen::Vector3d>> plane_normals(const std::vector<std::vector<int>>& clusters,
+                                                          const Eigen::Matrix3Xd& points, double link_distance) {
+  const double band = 0.3 * link_distance;
+  std::vector<std::optional<Eigen::Vector3d>> normals;
+  std::vector<std::pair<Eigen::Vector3d, double>> planes;  // normal, offset
+  for (const std::vector<int>& c : clusters) {
+    const Eigen::Matrix3Xd part = points(Eigen::all, c);
+    normals.push_back(wide_plane_normal(part, 0.5 * link_distance));
+    if (normals.back()) planes.emplace_back(*normals.back(), normals.back()->dot(part.rowwise().mean()));
+  }
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    if (normals[c]) continue;
+    for (const auto& [n, offset] : planes) {
+      const bool on = std::all_of(clusters[c].begin(), clusters[c].end(),
+                                  [&](int i) { return std::abs(n.dot(points.col(i)) - offset) <= band; });
+      if (on) {
+        normals[c] = n;
+        break;
+      }
+    }
+  }
+  return normals;
+}
+
 // Clusters that join occluders followed apart until now (a hand reaching the
 // table, two hands touching) are cut back into them, each part then owned by
 // its track. Each point of such a cluster goes to the track of the nearest
@@ -542,6 +571,7 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
   split_planes(clusters, occluders, settings_.link_distance);
   std::vector<int> owner;
   split_merged(tracks_, period, settings_.link_distance, clusters, occluders, owner);
+  const std::vector<std::optional<Eigen::Vector3d>> normals = plane_normals(clusters, occluders, settings_.link_distance);
   std::vector<Eigen::Vector3d> centroids;
   centroids.reserve(clusters.size());
   for (const auto& c : clusters) {
@@ -595,13 +625,12 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     // the centroid's offset from its prediction stands for the position's.
     const Eigen::Matrix3Xd now = occluders(Eigen::all, clusters[c]);
     std::optional<Eigen::Vector3d> moved;
-    std::optional<Eigen::Vector3d> plane;
+    const std::optional<Eigen::Vector3d>& plane = normals[c];
     bool registered = true;
     if (track.points.cols() > 0) {
-      // A wide plane registers from no motion alone: only the motion along
-      // its normal counts.
+      // A wide plane, or a piece of one, registers from no motion alone:
+      // only the motion along its normal counts.
       const Eigen::Vector3d centroid_shift = centroids[c] - (track.centroid - period * track.velocity);
-      plane = wide_plane_normal(now, 0.5 * settings_.link_distance);
       std::vector<Eigen::Vector3d> starts{Eigen::Vector3d::Zero()};
       if (!plane) starts.insert(starts.end(), {period * track.velocity, centroid_shift});
       moved = track_motion(track.points, now, starts, settings_.link_distance);
@@ -631,9 +660,9 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     const Eigen::Matrix2d i_kh = Eigen::Matrix2d::Identity() - gain * Eigen::RowVector2d(1.0, 0.0);
     track.covariance = i_kh * track.covariance;
     track.covariance = 0.5 * (track.covariance + track.covariance.transpose()).eval();
-    // A wide plane's motion within itself is not seen: none, not what the
-    // track had before it was one (a piece of table whose part in view
-    // changed while it was small, then joined by the rest of the table).
+    // A plane's motion within itself is not seen: none, not what the track
+    // had before (a piece of table too far from the rest to be seen as a
+    // piece of it, then joined by the rest).
     if (plane) track.velocity = plane->dot(track.velocity) * *plane;
     track.points = now;
     ++track.hits;

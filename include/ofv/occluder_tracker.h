@@ -36,7 +36,9 @@
  * shape cannot show moving (a capsule along its axis, ends unseen) is taken
  * as still. A wide plane (a table) is measured along its normal only (the
  * aperture problem), and its velocity within itself is none, whatever the
- * track had before it was one. When too few of the cluster's points find the
+ * track had before it was one; so is a piece of one (a cluster all of
+ * whose points lie within 0.3 x `link_distance` of a wide plane of the
+ * frame: a table seen in pieces past the object). When too few of the cluster's points find the
  * previous ones (the part seen grew), the previous points are registered
  * onto the cluster's; when neither registers, the track starts again where
  * the cluster is, with its id. The three axes are independent with the same
