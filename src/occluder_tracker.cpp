@@ -661,8 +661,8 @@ const std::vector<OccluderTrack>& OccluderTracker::update(const Eigen::Matrix3Xd
     track.covariance = i_kh * track.covariance;
     track.covariance = 0.5 * (track.covariance + track.covariance.transpose()).eval();
     // A plane's motion within itself is not seen: none, not what the track
-    // had before (a piece of table too far from the rest to be seen as a
-    // piece of it, then joined by the rest).
+    // had before (a piece of table seen in a frame without the rest of it,
+    // then joined by the rest).
     if (plane) track.velocity = plane->dot(track.velocity) * *plane;
     track.points = now;
     ++track.hits;

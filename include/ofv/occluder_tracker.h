@@ -38,10 +38,10 @@
  * aperture problem), and its velocity within itself is none, whatever the
  * track had before it was one; so is a piece of one (a cluster all of
  * whose points lie within 0.3 x `link_distance` of a wide plane of the
- * frame: a table seen in pieces past the object). When too few of the cluster's points find the
- * previous ones (the part seen grew), the previous points are registered
- * onto the cluster's; when neither registers, the track starts again where
- * the cluster is, with its id. The three axes are independent with the same
+ * frame: a table seen in pieces past the object). When too few of the
+ * cluster's points find the previous ones (the part seen grew), the
+ * previous points are registered onto the cluster's; when neither
+ * registers, the track starts again where the cluster is, with its id. The three axes are independent with the same
  * noises, so one 2 x 2 covariance (position, velocity of one axis) holds
  * for all three.
  *
