@@ -154,7 +154,15 @@ VispRobot::VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& 
   robot_.setRobotState(vpRobot::STATE_VELOCITY_CONTROL);
 }
 
-vpHomogeneousMatrix VispRobot::wMc() const { return wMf_ * fMc_(); }
+vpHomogeneousMatrix VispRobot::wMc() const {
+  const vpHomogeneousMatrix fMc = fMc_();
+  for (unsigned i = 0; i < 3; ++i) {
+    for (unsigned j = 0; j < 4; ++j) {
+      if (!std::isfinite(fMc[i][j])) throw std::runtime_error(name_ + ": the driver reported a camera pose that is not finite");
+    }
+  }
+  return wMf_ * fMc;
+}
 
 RobotStep VispRobot::step(const vpColVector& v, double dt) {
   robot_.setVelocity(vpRobot::CAMERA_FRAME, usable(v, dt) ? v : vpColVector(6, 0.0));

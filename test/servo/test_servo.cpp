@@ -10,6 +10,7 @@
 
 #include <limits>
 #include <visp3/core/vpExponentialMap.h>
+#include <visp3/robot/vpSimulatorCamera.h>
 
 #include <chrono>
 #include <random>
@@ -205,6 +206,32 @@ TEST(Robots, ArmsStayBoundedAtASingularity) {
     EXPECT_LE((to_eigen(arm.wMc()).translation() - p0).norm(), 1.05 * std::hypot(0.3, 0.2) * dt + 1e-3) << "step " << k;
     for (unsigned i = 0; i < 6; ++i) EXPECT_LE(std::abs(arm.joints()[i] - before[i]), 2.5 * dt + 1e-12) << "joint " << i;
   }
+}
+
+// A driver that reports a pose with NaN (ViSP's threaded Viper850 can, at its
+// wrist singularity) ends the run with an error naming the robot: the
+// pose must not reach the renderer or the controller.
+TEST(Robots, ADriverPoseThatIsNotFiniteIsAnError) {
+  vpSimulatorCamera driver;
+  bool faulty = false;
+  VispRobot robot(
+      driver,
+      [&faulty] {
+        vpHomogeneousMatrix fMc;
+        if (faulty) fMc[1][3] = std::numeric_limits<double>::quiet_NaN();
+        return fMc;
+      },
+      vpHomogeneousMatrix(), "test-arm");
+  EXPECT_TRUE(to_eigen(robot.wMc()).matrix().allFinite());
+  faulty = true;
+  try {
+    (void)robot.wMc();
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("test-arm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)robot.step(vpColVector(6, 0.0), 0.0), std::runtime_error);
 }
 
 TEST(Safety, EachRule) {

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 
 namespace ofv::sim {
@@ -229,6 +231,18 @@ TEST(Renderer, DepthOfAPlaneMatchesTheAnalyticValue) {
     const double expected = 0.995 / ray_w.z();  // Z of the hit along a unit-Z camera ray
     EXPECT_EQ(f.frame.depth[f.frame.index(u, v)], stored(expected)) << u << "," << v;
   }
+}
+
+TEST(Renderer, APoseThatIsNotFiniteIsRefused) {
+  const Scenario s = scenario_from_yaml("object: {shape: box, size: [1, 1, 0.01], position: [0, 0, 1]}", kSource);
+  Renderer r(s);
+  Eigen::Isometry3d wMc = s.wMc_start;
+  wMc.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)r.render(wMc, 0), std::invalid_argument);
+  wMc = s.wMc_start;
+  wMc.linear()(2, 2) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((void)r.render(wMc, 0), std::invalid_argument);
+  EXPECT_NO_THROW((void)r.render(s.wMc_start, 0));
 }
 
 TEST(Renderer, DepthOfASphereMatchesTheAnalyticValue) {
