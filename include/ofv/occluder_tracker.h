@@ -41,9 +41,9 @@
  * frame: a table seen in pieces past the object). When too few of the
  * cluster's points find the previous ones (the part seen grew), the
  * previous points are registered onto the cluster's; when neither
- * registers, the track starts again where the cluster is, with its id. The three axes are independent with the same
- * noises, so one 2 x 2 covariance (position, velocity of one axis) holds
- * for all three.
+ * registers, the track starts again where the cluster is, with its id.
+ * The three axes are independent with the same noises, so one 2 x 2
+ * covariance (position, velocity of one axis) holds for all three.
  *
  * Association: every track's last centroid is moved by its velocity to
  * the frame's time; cluster and track pairs whose centroids are closer than

@@ -194,8 +194,8 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index,
 
 void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const CameraIntrinsics& k, bool noise,
                       RenderedFrame& out) const {
-  // Embree takes a ray that is not finite for a programming error (an
-  // assertion that aborts): a pose read from a faulty driver is the caller's.
+  // Embree takes a ray that is not finite for a programming error and
+  // aborts: such a pose (from a faulty driver) is refused here.
   if (!wMc.matrix().allFinite()) throw std::invalid_argument("renderer: the camera pose is not finite");
   RgbdFrame& f = out.frame;
   f.timestamp = time_;
