@@ -274,11 +274,12 @@ std::vector<std::optional<Eigen::Vector3d>> plane_normals(const std::vector<std:
   }
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     if (normals[c]) continue;
-    for (const auto& [n, offset] : planes) {
-      const bool on = std::all_of(clusters[c].begin(), clusters[c].end(),
-                                  [&](int i) { return std::abs(n.dot(points.col(i)) - offset) <= band; });
+    for (const auto& plane : planes) {
+      const bool on = std::all_of(clusters[c].begin(), clusters[c].end(), [&](int i) {
+        return std::abs(plane.first.dot(points.col(i)) - plane.second) <= band;
+      });
       if (on) {
-        normals[c] = n;
+        normals[c] = plane.first;
         break;
       }
     }
