@@ -1,6 +1,7 @@
 // Robots: free-flying camera, kinematic Viper850/Afma6, any vpRobot.
 #include "ofv/servo/robot.h"
 
+#include "ofv/servo/target_pose.h"
 #include "ofv/settings_table.h"
 
 #include <visp3/core/vpPoseVector.h>
@@ -156,10 +157,8 @@ VispRobot::VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& 
 
 vpHomogeneousMatrix VispRobot::wMc() const {
   const vpHomogeneousMatrix fMc = fMc_();
-  for (unsigned i = 0; i < 3; ++i) {
-    for (unsigned j = 0; j < 4; ++j) {
-      if (!std::isfinite(fMc[i][j])) throw std::runtime_error(name_ + ": the driver reported a camera pose that is not finite");
-    }
+  if (!to_eigen(fMc).matrix().allFinite()) {
+    throw std::runtime_error(name_ + ": the driver reported a camera pose that is not finite");
   }
   return wMf_ * fMc;
 }
