@@ -41,6 +41,24 @@ bool usable(const vpColVector& v, double dt) {
   return true;
 }
 
+// Joint velocities for the camera twist v by damped least squares on the
+// camera-frame Jacobian cJ: near a singularity the pseudo-inverse would ask
+// for unbounded joint speeds.
+vpColVector damped_joint_velocity(const vpMatrix& cJ, const vpColVector& v) {
+  vpMatrix JJt = cJ * cJ.t();
+  for (unsigned i = 0; i < 6; ++i) JJt[i][i] += kDamping * kDamping;
+  return cJ.t() * (JJt.inverseByLU() * v);
+}
+
+// The factor (at most 1) that keeps every joint within kMaxJointSpeed.
+double joint_speed_scale(const vpColVector& qdot) {
+  double scale = 1.0;
+  for (unsigned i = 0; i < qdot.size(); ++i) {
+    if (std::abs(qdot[i]) > kMaxJointSpeed) scale = std::min(scale, kMaxJointSpeed / std::abs(qdot[i]));
+  }
+  return scale;
+}
+
 }  // namespace
 
 FreeFlyingCamera::FreeFlyingCamera(const vpHomogeneousMatrix& wMc) {
@@ -124,20 +142,12 @@ void KinematicArm::set_joints(const vpColVector& q) {
 RobotStep KinematicArm::step(const vpColVector& v, double dt) {
   RobotStep r;
   if (usable(v, dt)) {
-    // Damped least squares: near a singularity the pseudo-inverse would ask
-    // for unbounded joint speeds.
-    const vpMatrix J = impl_->cJ(q_);
-    vpMatrix JJt = J * J.t();
-    for (unsigned i = 0; i < 6; ++i) JJt[i][i] += kDamping * kDamping;
-    const vpColVector qdot = J.t() * (JJt.inverseByLU() * v);
+    const vpColVector qdot = damped_joint_velocity(impl_->cJ(q_), v);
     const vpColVector lo = joint_min(), hi = joint_max();
     // The whole step shortened so that no joint exceeds its speed or passes
     // its limit: the camera keeps the commanded direction (clamping joints one
     // by one would turn it) and slows down or stops.
-    double scale = 1.0;
-    for (unsigned i = 0; i < 6; ++i) {
-      if (std::abs(qdot[i]) > kMaxJointSpeed) scale = std::min(scale, kMaxJointSpeed / std::abs(qdot[i]));
-    }
+    double scale = joint_speed_scale(qdot);
     for (unsigned i = 0; i < 6; ++i) {
       const double dq = qdot[i] * dt;
       const double room = dq > 0.0 ? hi[i] - q_[i] : lo[i] - q_[i];
@@ -150,8 +160,10 @@ RobotStep KinematicArm::step(const vpColVector& v, double dt) {
   return r;
 }
 
-VispRobot::VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name)
-    : robot_(robot), fMc_(std::move(fMc)), wMf_(fMw.inverse()), name_(std::move(name)) {
+VispRobot::VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name,
+                     Command command)
+    : robot_(robot), fMc_(std::move(fMc)), command_(std::move(command)), wMf_(fMw.inverse()), name_(std::move(name)) {
+  if (!command_) command_ = [&robot](const vpColVector& v) { robot.setVelocity(vpRobot::CAMERA_FRAME, v); };
   robot_.setRobotState(vpRobot::STATE_VELOCITY_CONTROL);
 }
 
@@ -164,7 +176,7 @@ vpHomogeneousMatrix VispRobot::wMc() const {
 }
 
 RobotStep VispRobot::step(const vpColVector& v, double dt) {
-  robot_.setVelocity(vpRobot::CAMERA_FRAME, usable(v, dt) ? v : vpColVector(6, 0.0));
+  command_(usable(v, dt) ? v : vpColVector(6, 0.0));
   // Keep the cadence: this period ends one dt after the previous one did;
   // after an overrun, at once.
   const double now = vpTime::measureTimeMs();
@@ -173,7 +185,7 @@ RobotStep VispRobot::step(const vpColVector& v, double dt) {
   return {wMc(), false};
 }
 
-void VispRobot::stop() { robot_.setVelocity(vpRobot::CAMERA_FRAME, vpColVector(6, 0.0)); }
+void VispRobot::stop() { command_(vpColVector(6, 0.0)); }
 
 #if defined(OFV_HAVE_THREADED_SIMULATORS)
 namespace {
@@ -221,7 +233,35 @@ struct ThreadedArm::Impl {
   std::unique_ptr<vpRobot> simulator;
   std::unique_ptr<VispRobot> robot;
   std::string name;
+  std::function<vpColVector()> joints;
+  vpColVector lo, hi;  // the simulator's joint limits
 };
+
+namespace {
+
+// How long [s] a joint heading for its limit may keep its speed: it slows
+// down as it nears the margin, so that a loop that stalls for less than this
+// does not carry it onto the limit (the simulator integrates in wall-clock
+// time).
+constexpr double kLimitBrakeTime = 0.25;
+
+// The joint velocities ThreadedArm sends for the camera twist v at joints q:
+// damped least squares on cJ, scaled down (direction kept) for the joint
+// speed limit and so that no joint heading for its limit comes within
+// ThreadedArm::kJointLimitMargin of it.
+vpColVector guarded_joint_velocity(const vpMatrix& cJ, const vpColVector& v, const vpColVector& q,
+                                   const vpColVector& lo, const vpColVector& hi) {
+  const vpColVector qdot = damped_joint_velocity(cJ, v);
+  double scale = joint_speed_scale(qdot);
+  for (unsigned i = 0; i < 6; ++i) {
+    const double room = (qdot[i] > 0.0 ? hi[i] - q[i] : q[i] - lo[i]) - ThreadedArm::kJointLimitMargin;
+    const double allowed = std::max(0.0, room) / kLimitBrakeTime;
+    if (std::abs(qdot[i]) > allowed) scale = std::min(scale, allowed / std::abs(qdot[i]));
+  }
+  return scale * qdot;
+}
+
+}  // namespace
 
 ThreadedArm::ThreadedArm(KinematicArm::Model model, const vpHomogeneousMatrix& wMc_start)
     : impl_(std::make_unique<Impl>()) {
@@ -236,7 +276,23 @@ ThreadedArm::ThreadedArm(KinematicArm::Model model, const vpHomogeneousMatrix& w
     vpPoseVector p;
     simulator->getPosition(vpRobot::REFERENCE_FRAME, p);
     const vpHomogeneousMatrix fMw = vpHomogeneousMatrix(p) * wMc_start.inverse();
-    impl_->robot = std::make_unique<VispRobot>(*simulator, fMw, name);
+    auto* sim = simulator.get();
+    impl_->joints = [sim] {
+      vpColVector q;
+      sim->getPosition(vpRobot::ARTICULAR_FRAME, q);
+      return q;
+    };
+    impl_->lo = sim->getJointMin();
+    impl_->hi = sim->getJointMax();
+    auto command = [sim, joints = impl_->joints, lo = impl_->lo, hi = impl_->hi](const vpColVector& v) {
+      // The simulator's own Jacobian at its current joints.
+      vpMatrix eJe;
+      vpVelocityTwistMatrix cVe;
+      sim->get_eJe(eJe);
+      sim->get_cVe(cVe);
+      sim->setVelocity(vpRobot::ARTICULAR_FRAME, guarded_joint_velocity(cVe * eJe, v, joints(), lo, hi));
+    };
+    impl_->robot = std::make_unique<VispRobot>(*simulator, fMw, name, command);
     impl_->simulator = std::move(simulator);
     impl_->name = name;
   };
@@ -253,6 +309,9 @@ ThreadedArm::~ThreadedArm() {
 vpHomogeneousMatrix ThreadedArm::wMc() const { return impl_->robot->wMc(); }
 RobotStep ThreadedArm::step(const vpColVector& v, double dt) { return impl_->robot->step(v, dt); }
 std::string ThreadedArm::name() const { return impl_->name; }
+vpColVector ThreadedArm::joints() const { return impl_->joints(); }
+vpColVector ThreadedArm::joint_min() const { return impl_->lo; }
+vpColVector ThreadedArm::joint_max() const { return impl_->hi; }
 #else
 struct ThreadedArm::Impl {};
 ThreadedArm::ThreadedArm(KinematicArm::Model, const vpHomogeneousMatrix&) {
@@ -262,6 +321,9 @@ ThreadedArm::~ThreadedArm() = default;
 vpHomogeneousMatrix ThreadedArm::wMc() const { return {}; }
 RobotStep ThreadedArm::step(const vpColVector&, double) { return {}; }
 std::string ThreadedArm::name() const { return {}; }
+vpColVector ThreadedArm::joints() const { return {}; }
+vpColVector ThreadedArm::joint_min() const { return {}; }
+vpColVector ThreadedArm::joint_max() const { return {}; }
 #endif
 
 const char* to_string(RobotKind kind) {

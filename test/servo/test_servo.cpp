@@ -177,6 +177,35 @@ TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
   EXPECT_THROW((void)make_robot(RobotKind::Camera, start, /*real_time=*/true), std::invalid_argument);
 }
 
+// Driven into a joint limit and then held still, the threaded arm stops
+// short of the limit and its pose stays finite: ViSP's simulators turn every
+// joint into NaN when a joint standing on its limit gets no velocity.
+TEST(Robots, ThreadedArmStopsShortOfItsJointLimits) {
+  const vpHomogeneousMatrix start = looking_at({0.1, -0.05, 0}, {0, 0, 0.5});
+  const double dt = 1.0 / 30.0;
+  // Twists that bring the wrist (joint 5) onto its limit within a second,
+  // sent for 40 frames.
+  for (const auto& [model, v] : {std::pair{KinematicArm::Model::Viper850, vpColVector{0, 0, -0.3, 0, 0, 0}},
+                                 std::pair{KinematicArm::Model::Afma6, vpColVector{0, 0, 0, -1.0, 0, 0}}}) {
+    ThreadedArm arm(model, start);
+    const vpColVector lo = arm.joint_min(), hi = arm.joint_max();
+    for (int k = 0; k < 45; ++k) {
+      (void)arm.step(k < 40 ? v : vpColVector(6, 0.0), dt);
+      const vpColVector q = arm.joints();
+      for (unsigned i = 0; i < 6; ++i) {
+        ASSERT_TRUE(std::isfinite(q[i])) << arm.name() << " step " << k;
+        EXPECT_GE(q[i] - lo[i], 0.5 * ThreadedArm::kJointLimitMargin) << arm.name() << " joint " << i << " step " << k;
+        EXPECT_GE(hi[i] - q[i], 0.5 * ThreadedArm::kJointLimitMargin) << arm.name() << " joint " << i << " step " << k;
+      }
+    }
+    const vpColVector q = arm.joints();
+    double nearest = 1e9;
+    for (unsigned i = 0; i < 6; ++i) nearest = std::min({nearest, q[i] - lo[i], hi[i] - q[i]});
+    EXPECT_LT(nearest, 0.1) << arm.name() << ": the twist should have brought a joint near its limit";
+    EXPECT_TRUE(to_eigen(arm.wMc()).matrix().allFinite()) << arm.name();
+  }
+}
+
 TEST(Robots, JointLimitsClamp) {
   KinematicArm arm(KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
   bool limited = false;

@@ -102,7 +102,7 @@ class KinematicArm : public CameraRobot {
  * \brief Any ViSP robot (a real driver such as vpRobotViper850, vpRobotAfma6,
  *        vpRobotFranka, vpRobotUniversalRobots, or a threaded simulator),
  *        commanded in the camera frame. step() sends the velocity with
- *        setVelocity(CAMERA_FRAME) and waits until one period after the
+ *        setVelocity(CAMERA_FRAME) (or `command`) and waits until one period after the
  *        previous step began (vpTime::wait), so that the loop keeps the frame
  *        rate whatever its compute time; the camera pose is read back with
  *        getPosition(REFERENCE_FRAME, vpPoseVector&) (θu: the vpColVector
@@ -112,16 +112,19 @@ class VispRobot : public CameraRobot {
  public:
   /// \brief Reads the camera pose in the robot's reference frame, fMc.
   using PoseReader = std::function<vpHomogeneousMatrix()>;
+  /// \brief Sends a camera twist to the robot (ThreadedArm sends joint velocities).
+  using Command = std::function<void(const vpColVector& v)>;
   /// \brief `Driver`: any vpRobot with getPosition(vpRobot::REFERENCE_FRAME, vpPoseVector&).
+  /// \param command sends the twist; empty: setVelocity(CAMERA_FRAME, v).
   template <class Driver>
-  VispRobot(Driver& robot, const vpHomogeneousMatrix& fMw, std::string name)
+  VispRobot(Driver& robot, const vpHomogeneousMatrix& fMw, std::string name, Command command = {})
       : VispRobot(static_cast<vpRobot&>(robot), PoseReader([&robot] {
                     vpPoseVector p;
                     robot.getPosition(vpRobot::REFERENCE_FRAME, p);
                     return vpHomogeneousMatrix(p);
                   }),
-                  fMw, std::move(name)) {}
-  VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name);
+                  fMw, std::move(name), std::move(command)) {}
+  VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name, Command command = {});
   [[nodiscard]] vpHomogeneousMatrix wMc() const override;
   RobotStep step(const vpColVector& v, double dt) override;
   [[nodiscard]] std::string name() const override { return name_; }
@@ -131,6 +134,7 @@ class VispRobot : public CameraRobot {
  private:
   vpRobot& robot_;
   PoseReader fMc_;
+  Command command_;
   vpHomogeneousMatrix wMf_;
   std::string name_;
   double next_ms_ = -1.0;  // when the current period ends (vpTime::measureTimeMs)
@@ -142,7 +146,13 @@ class VispRobot : public CameraRobot {
  *        an episode runs in real time and is not exactly repeatable. For
  *        demos; KinematicArm is the deterministic twin. The arm starts in
  *        KinematicArm::start_joints(), its base placed so that the camera is
- *        at `wMc_start`.
+ *        at `wMc_start`. The twist is sent as joint velocities, by damped
+ *        least squares on the simulator's own Jacobian, and slowed so that no
+ *        joint comes within `kJointLimitMargin` of its limit: ViSP 3.5's
+ *        simulators turn every joint into NaN when a joint that stands on its
+ *        limit is given no velocity of its own (vpSimulatorViper850::
+ *        updateArticularPosition divides by that velocity), and their
+ *        pseudo-inverse is undamped at the wrist singularity.
  */
 class ThreadedArm : public CameraRobot {
  public:
@@ -152,6 +162,12 @@ class ThreadedArm : public CameraRobot {
   [[nodiscard]] vpHomogeneousMatrix wMc() const override;
   RobotStep step(const vpColVector& v, double dt) override;
   [[nodiscard]] std::string name() const override;
+  /// \brief The simulator's joints now, and its limits (its own, narrower than KinematicArm's on the Viper850).
+  [[nodiscard]] vpColVector joints() const;
+  [[nodiscard]] vpColVector joint_min() const;
+  [[nodiscard]] vpColVector joint_max() const;
+  /// \brief How close [rad or m] a joint may come to its limit.
+  static constexpr double kJointLimitMargin = 0.02;
 
  private:
   struct Impl;
