@@ -50,15 +50,6 @@ vpColVector damped_joint_velocity(const vpMatrix& cJ, const vpColVector& v) {
   return cJ.t() * (JJt.inverseByLU() * v);
 }
 
-// The factor (at most 1) that keeps every joint within kMaxJointSpeed.
-double joint_speed_scale(const vpColVector& qdot) {
-  double scale = 1.0;
-  for (unsigned i = 0; i < qdot.size(); ++i) {
-    if (std::abs(qdot[i]) > kMaxJointSpeed) scale = std::min(scale, kMaxJointSpeed / std::abs(qdot[i]));
-  }
-  return scale;
-}
-
 }  // namespace
 
 FreeFlyingCamera::FreeFlyingCamera(const vpHomogeneousMatrix& wMc) {
@@ -147,7 +138,10 @@ RobotStep KinematicArm::step(const vpColVector& v, double dt) {
     // The whole step shortened so that no joint exceeds its speed or passes
     // its limit: the camera keeps the commanded direction (clamping joints one
     // by one would turn it) and slows down or stops.
-    double scale = joint_speed_scale(qdot);
+    double scale = 1.0;
+    for (unsigned i = 0; i < 6; ++i) {
+      if (std::abs(qdot[i]) > kMaxJointSpeed) scale = std::min(scale, kMaxJointSpeed / std::abs(qdot[i]));
+    }
     for (unsigned i = 0; i < 6; ++i) {
       const double dq = qdot[i] * dt;
       const double room = dq > 0.0 ? hi[i] - q_[i] : lo[i] - q_[i];
@@ -245,20 +239,20 @@ namespace {
 // time).
 constexpr double kLimitBrakeTime = 0.25;
 
-// The joint velocities ThreadedArm sends for the camera twist v at joints q:
-// damped least squares on cJ, scaled down (direction kept) for the joint
-// speed limit and so that no joint heading for its limit comes within
-// ThreadedArm::kJointLimitMargin of it.
-vpColVector guarded_joint_velocity(const vpMatrix& cJ, const vpColVector& v, const vpColVector& q,
-                                   const vpColVector& lo, const vpColVector& hi) {
+// The factor (at most 1) ThreadedArm scales the camera twist v by at joints
+// q: so that no joint, its velocity estimated by damped least squares on
+// cJ, heads for its limit faster than it can brake before
+// ThreadedArm::kJointLimitMargin.
+double limit_scale(const vpMatrix& cJ, const vpColVector& v, const vpColVector& q, const vpColVector& lo,
+                   const vpColVector& hi) {
   const vpColVector qdot = damped_joint_velocity(cJ, v);
-  double scale = joint_speed_scale(qdot);
+  double scale = 1.0;
   for (unsigned i = 0; i < 6; ++i) {
     const double room = (qdot[i] > 0.0 ? hi[i] - q[i] : q[i] - lo[i]) - ThreadedArm::kJointLimitMargin;
     const double allowed = std::max(0.0, room) / kLimitBrakeTime;
     if (std::abs(qdot[i]) > allowed) scale = std::min(scale, allowed / std::abs(qdot[i]));
   }
-  return scale * qdot;
+  return scale;
 }
 
 }  // namespace
@@ -290,7 +284,7 @@ ThreadedArm::ThreadedArm(KinematicArm::Model model, const vpHomogeneousMatrix& w
       vpVelocityTwistMatrix cVe;
       sim->get_eJe(eJe);
       sim->get_cVe(cVe);
-      sim->setVelocity(vpRobot::ARTICULAR_FRAME, guarded_joint_velocity(cVe * eJe, v, joints(), lo, hi));
+      sim->setVelocity(vpRobot::CAMERA_FRAME, limit_scale(cVe * eJe, v, joints(), lo, hi) * v);
     };
     impl_->robot = std::make_unique<VispRobot>(*simulator, fMw, name, command);
     impl_->simulator = std::move(simulator);

@@ -112,7 +112,7 @@ class VispRobot : public CameraRobot {
  public:
   /// \brief Reads the camera pose in the robot's reference frame, fMc.
   using PoseReader = std::function<vpHomogeneousMatrix()>;
-  /// \brief Sends a camera twist to the robot (ThreadedArm sends joint velocities).
+  /// \brief Sends a camera twist to the robot (ThreadedArm slows it near joint limits).
   using Command = std::function<void(const vpColVector& v)>;
   /// \brief `Driver`: any vpRobot with getPosition(vpRobot::REFERENCE_FRAME, vpPoseVector&).
   /// \param command sends the twist; empty: setVelocity(CAMERA_FRAME, v).
@@ -146,13 +146,12 @@ class VispRobot : public CameraRobot {
  *        an episode runs in real time and is not exactly repeatable. For
  *        demos; KinematicArm is the deterministic twin. The arm starts in
  *        KinematicArm::start_joints(), its base placed so that the camera is
- *        at `wMc_start`. The twist is sent as joint velocities, by damped
- *        least squares on the simulator's own Jacobian, and slowed so that no
- *        joint comes within `kJointLimitMargin` of its limit: ViSP 3.5's
- *        simulators turn every joint into NaN when a joint that stands on its
- *        limit is given no velocity of its own (vpSimulatorViper850::
- *        updateArticularPosition divides by that velocity), and their
- *        pseudo-inverse is undamped at the wrist singularity.
+ *        at `wMc_start`. The twist is slowed (its direction kept) so that no
+ *        joint, its velocity estimated by damped least squares on the
+ *        simulator's Jacobian, comes within `kJointLimitMargin` of its
+ *        limit: ViSP 3.5's simulators turn every joint into NaN when a joint
+ *        that stands on its limit is given no velocity of its own
+ *        (vpSimulatorViper850::updateArticularPosition divides by it).
  */
 class ThreadedArm : public CameraRobot {
  public:
