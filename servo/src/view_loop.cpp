@@ -131,6 +131,10 @@ SettingsTable<LoopSettings> make_table() {
          "perception=full: an occluder the image border cuts goes on beyond it, to the sphere (false: only what the frame shows)"},
         [](L& l, const std::string& v) { l.beyond_view = parse_bool("beyond_view", v); },
         [](const L& l) { return format_bool(l.beyond_view); });
+  t.add({"behind_occluders", "bool", format_bool(d.behind_occluders), "",
+         "perception=full: when an occluder cuts the object in the first frame, the object goes on behind it (false: only what has been seen)"},
+        [](L& l, const std::string& v) { l.behind_occluders = parse_bool("behind_occluders", v); },
+        [](const L& l) { return format_bool(l.behind_occluders); });
   t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",
          "while t0 is occluded, continue from the previous target (warm start) instead of re-estimating from t0"},
         [](L& l, const std::string& v) { l.target_hysteresis = parse_bool("target_hysteresis", v); },

@@ -99,7 +99,18 @@ struct Perception::Impl {
   std::vector<Eigen::Vector3f> moved;
   std::vector<Eigen::Vector3f> moved_normals;
   detail::PointGrid moved_grid;
+  std::vector<Eigen::Vector3f> moved_chroma;
   std::vector<Eigen::Vector3f> outline, outline_normals;
+  // Where an occluder cuts the seen object (object_motion()): the last
+  // surface point, the outline's outward direction, the surface's
+  // chromaticity there, and how much nearer the camera the occluder is [m].
+  struct Cut {
+    Eigen::Vector3f point, outward, chroma;
+    double gap;
+  };
+  std::vector<Cut> cuts;
+  detail::PointGrid around;  // behind_occluders(): the seen voxels near a cut
+  std::vector<Eigen::Vector3d> near_cut;
   std::vector<Eigen::Vector3f> previous_outline, previous_outline_normals;
   detail::PointGrid outline_grid;
 
@@ -112,6 +123,7 @@ struct Perception::Impl {
   std::vector<Eigen::Vector3f> memory_normal;  // its supervoxel's normal then (0: none)
   detail::PointGrid seen_grid;                 // the frame's object voxels (remember())
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
+  bool incomplete = false;  // the first frame showed an occluder cutting the object (behind_occluders())
   std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
 
@@ -158,8 +170,12 @@ struct Perception::Impl {
   Eigen::Isometry3d object_motion(const RgbdFrame& frame, const PerceptionResult& r,
                                   const std::vector<char>& object);
   /// object_memory.cpp: the memory updated with the frame's object; its
-  /// hidden part moved by object_motion() first.
-  void remember(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<char>& object);
+  /// hidden part moved by object_motion() first; then behind_occluders().
+  void remember(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object);
+  /// object_memory.cpp: the object presumed to go on behind the occluders
+  /// that cut it, as hidden memory voxels (PerceptionSettings::behind_occluders);
+  /// sets r.counts.presumed_voxels.
+  void behind_occluders(const RgbdFrame& frame, PerceptionResult& r);
   /// classify.cpp: C, axes, OBB, labels and r.problem.
   void classify(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object);
   /// classify.cpp: occluder points beyond the image border, where the

@@ -4,12 +4,15 @@
 #include "front_end.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace ofv {
@@ -67,24 +70,49 @@ int nearest(const detail::PointGrid& grid, const std::vector<Eigen::Vector3f>& p
   return best;
 }
 
+/// The plane of points `d` (mean, unit normal): least squares, refitted
+/// three times to the points within `inlier` of the last fit, so that the
+/// larger face wins where two meet; nullopt with fewer than 10 on it.
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> surface_plane(const std::vector<Eigen::Vector3d>& d,
+                                                                         double inlier) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (int fit = 0; fit < 3; ++fit) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    std::size_t count = 0;
+    for (const Eigen::Vector3d& x : d) {
+      if (fit > 0 && std::abs(normal.dot(x - mean)) > inlier) continue;
+      sum += x;
+      scatter += x * x.transpose();
+      ++count;
+    }
+    if (count < 10) return std::nullopt;
+    mean = sum / static_cast<double>(count);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter / static_cast<double>(count) -
+                                                             mean * mean.transpose());
+    normal = eig.eigenvectors().col(0);
+  }
+  return std::make_pair(mean, normal);
+}
+
 }  // namespace
 
 Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
                                                   const PerceptionResult& r,
                                                   const std::vector<char>& object) {
   const TrackingSettings& t = settings.tracking;
-  if (!t.follow_motion) {
-    return Eigen::Isometry3d::Identity();
-  }
   const double res = settings.supervoxels.voxel_resolution;
   // The frame's object voxels (those that may enter the memory), each with
   // its supervoxel's normal.
   moved.clear();
   moved_normals.clear();
+  moved_chroma.clear();
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     if (object[owner] && voxel_matched[i]) {
       moved.push_back(r.voxels[i]);
+      moved_chroma.push_back(chroma(sv.colours[i]));
       moved_normals.push_back(r.supervoxels[owner].normal_valid
                                   ? Eigen::Vector3f(r.supervoxels[owner].normal.cast<float>())
                                   : Eigen::Vector3f::Zero());
@@ -103,9 +131,10 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
   // The outline found in the depth image, to the pixel: from voxel p walk
   // outward (m) over the pixels while they show the surface; the last one is
   // the edge. nullopt when what lies beyond is nearer the camera (an
-  // occluder cuts the object there) or the walk leaves the image.
-  const auto edge = [&](const Eigen::Vector3d& p,
-                        const Eigen::Vector3d& m) -> std::optional<Eigen::Vector3f> {
+  // occluder cuts the object there: the last surface point and how much
+  // nearer the occluder is go to `cut`) or the walk leaves the image.
+  const auto edge = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& m,
+                        std::optional<std::pair<Eigen::Vector3f, double>>& cut) -> std::optional<Eigen::Vector3f> {
     double z0 = 0.0;
     double z1 = 0.0;
     const auto p0 = detail::project(frame, cMw, p, &z0);
@@ -136,7 +165,11 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
         s_last = s;
         continue;
       }
-      if (d < expected - in_front || !last) return std::nullopt;  // occluded edge
+      if (d < expected - in_front) {  // occluded edge
+        cut.emplace(last ? *last : p.cast<float>(), expected - d);
+        return std::nullopt;
+      }
+      if (!last) return std::nullopt;
       return s_last < max_steps ? last : std::nullopt;
     }
     // Nothing seen beyond the surface (out of range, or drop-outs): the
@@ -145,6 +178,7 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
   };
   outline.clear();
   outline_normals.clear();
+  cuts.clear();
   for (std::size_t i = 0; i < moved.size(); ++i) {
     const Eigen::Vector3f& p = moved[i];
     Eigen::Vector3f offset = Eigen::Vector3f::Zero();
@@ -162,15 +196,18 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
     offset -= n * n.dot(offset);  // within the surface (n = 0: as is)
     if (offset.norm() < static_cast<float>(0.35 * res)) continue;  // inside
     const Eigen::Vector3f m = -offset.normalized();
-    if (const auto e = edge(p.cast<double>(), m.cast<double>())) {
+    std::optional<std::pair<Eigen::Vector3f, double>> cut;
+    if (const auto e = edge(p.cast<double>(), m.cast<double>(), cut)) {
       outline.push_back(*e);
       outline_normals.push_back(m);
+    } else if (cut) {
+      cuts.push_back({cut->first, m, moved_chroma[i], cut->second});
     }
   }
 
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
   const std::size_t min_points = 20;
-  if (memory.size() >= min_points && moved.size() >= min_points) {
+  if (t.follow_motion && memory.size() >= min_points && moved.size() >= min_points) {
     // Gauss-Newton on A, this frame -> the previous (x -> R (x - c) + c + t,
     // small angles): point-to-plane to the nearest memory voxel, and along
     // the outline's normal to the nearest previous outline voxel facing the
@@ -245,7 +282,7 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
   return motion;
 }
 
-void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& r,
+void Perception::Impl::remember(const RgbdFrame& frame, PerceptionResult& r,
                                 const std::vector<char>& object) {
   // Old object voxels not seen in this frame (behind something nearer the
   // camera, out of the image, or on a pixel with no depth away from the seen
@@ -299,6 +336,114 @@ void Perception::Impl::remember(const RgbdFrame& frame, const PerceptionResult& 
   memory_chroma.swap(next_chroma);
   memory_age.swap(next_age);
   memory_normal.swap(next_normal);
+  behind_occluders(frame, r);
+}
+
+void Perception::Impl::behind_occluders(const RgbdFrame& frame, PerceptionResult& r) {
+  // The cuts by an occluder: nearer the camera than the OBB's margin, so
+  // not a hand holding the object by its edge.
+  const double min_gap = settings.obb_margin;
+  const auto deep = static_cast<std::size_t>(
+      std::count_if(cuts.begin(), cuts.end(), [&](const Cut& c) { return c.gap > min_gap; }));
+  if (r.status == TrackingStatus::Initialised) {
+    // A few voxels (not noise), and no more than the object's own outline
+    // (object_motion() has just made the frame's outline the previous one):
+    // one side cut, not an object seen through the gaps of a cage, whose
+    // seen parts tell too little of the rest.
+    incomplete = deep >= 3 && deep <= previous_outline.size();
+  } else if (deep == 0) {
+    incomplete = false;  // seen with nothing in front: its extent is known
+  }
+  if (!settings.behind_occluders || !incomplete || moved.empty()) return;
+
+  const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
+  const Eigen::Isometry3d cMw = frame.wMc.inverse();
+  const CameraIntrinsics& k = frame.intrinsics;
+  const double tolerance = settings.tracking.max_motion;
+  using Cell = Eigen::Matrix<std::int64_t, 3, 1>;
+  struct Presumed {
+    Cell cell;
+    std::size_t cut;
+    Eigen::Vector3f p, normal;
+  };
+  std::vector<Presumed> found;
+  const auto reach = static_cast<float>(2.0 * settings.supervoxels.seed_resolution);
+  const double camera_side =
+      plane ? (plane->head<3>().dot(frame.wMc.translation()) + (*plane)(3) < 0.0 ? -1.0 : 1.0) : 1.0;
+  around.build(moved, reach);
+  for (std::size_t c = 0; c < cuts.size(); ++c) {
+    const Cut& cut = cuts[c];
+    if (!(cut.gap > min_gap)) continue;
+    // The plane of the seen surface around the cut (a supervoxel's normal
+    // bends at the object's edges).
+    near_cut.clear();
+    around.for_each_near(cut.point, [&](int j) {
+      const Eigen::Vector3f d = moved[static_cast<std::size_t>(j)] - cut.point;
+      if (d.squaredNorm() <= reach * reach) near_cut.push_back(d.cast<double>());
+    });
+    const auto fitted = surface_plane(near_cut, 0.5 * res);
+    if (!fitted) continue;
+    Eigen::Vector3f normal = fitted->second.cast<float>();
+    const Eigen::Vector3f start = cut.point + normal * normal.dot(fitted->first.cast<float>());
+    if (normal.dot(frame.wMc.translation().cast<float>() - start) < 0.0f) normal = -normal;
+    Eigen::Vector3f outward = cut.outward - normal * normal.dot(cut.outward);
+    if (outward.norm() < 0.5f) continue;
+    outward.normalize();
+    // Across the line of sight only: a surface seen at a grazing angle (the
+    // top of a box seen from above) is not continued towards the camera.
+    const Eigen::Vector3f ray = (start - frame.wMc.translation().cast<float>()).normalized();
+    if (std::abs(ray.dot(outward)) > 0.5f) continue;
+    // The surface continued in its plane, outwards from the cut, while a
+    // surface nearer the camera hides it there, and at most as far as the
+    // seen part is wide that way.
+    float lo = 0.0f, hi = 0.0f;
+    for (const Eigen::Vector3f& p : moved) {
+      const float x = outward.dot(p - start);
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    const int steps = static_cast<int>(std::ceil((hi - lo) / res));
+    for (int j = 1; j <= steps; ++j) {
+      const Eigen::Vector3f q = start + (static_cast<float>(j) * res) * outward;
+      double z = 0.0;
+      const auto px = detail::project(frame, cMw, q.cast<double>(), &z);
+      if (!px) break;
+      const int u = static_cast<int>(std::lround(px->x()));
+      const int v = static_cast<int>(std::lround(px->y()));
+      if (u < 0 || v < 0 || u >= k.width || v >= k.height) break;
+      const float observed = frame.depth[frame.index(u, v)];
+      if (!(std::isfinite(observed) && static_cast<double>(observed) < z - tolerance)) break;
+      // Not into or behind the support plane, nor hidden by it.
+      if (plane) {
+        const auto d = static_cast<double>(observed);
+        const Eigen::Vector3d hider =
+            frame.wMc * Eigen::Vector3d((px->x() - k.cx) * d / k.fx, (px->y() - k.cy) * d / k.fy, d);
+        const double side = plane->head<3>().dot(q.cast<double>()) + (*plane)(3);
+        if (side * camera_side <= settings.tracking.plane_distance ||
+            std::abs(plane->head<3>().dot(hider) + (*plane)(3)) <= settings.tracking.plane_distance) {
+          break;
+        }
+      }
+      found.push_back({(q / res).array().floor().cast<std::int64_t>(), c, q, normal});
+    }
+  }
+  std::sort(found.begin(), found.end(), [](const Presumed& a, const Presumed& b) {
+    return std::lexicographical_compare(a.cell.data(), a.cell.data() + 3, b.cell.data(), b.cell.data() + 3);
+  });
+  found.erase(std::unique(found.begin(), found.end(),
+                          [](const Presumed& a, const Presumed& b) { return a.cell == b.cell; }),
+              found.end());
+  // Where the object is remembered already, the memory holds it.
+  grid.build(memory, res);
+  const std::size_t before = memory.size();
+  for (const Presumed& f : found) {
+    if (grid.any_within(f.p, 0.75f * res, [](int) { return true; })) continue;
+    memory.push_back(f.p);
+    memory_chroma.push_back(cuts[f.cut].chroma);
+    memory_age.push_back(1);
+    memory_normal.push_back(f.normal);
+  }
+  r.counts.presumed_voxels = memory.size() - before;
 }
 
 }  // namespace ofv

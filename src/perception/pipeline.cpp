@@ -144,6 +144,7 @@ void Perception::reset() {
   impl_->previous_outline_normals.clear();
   impl_->initial_voxels = 0;
   impl_->plane.reset();
+  impl_->incomplete = false;
 }
 
 const PerceptionSettings& Perception::settings() const { return impl_->settings; }

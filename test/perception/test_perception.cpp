@@ -420,6 +420,71 @@ TEST(Perception, HiddenPartOfAStaticObjectDoesNotDrift) {
   EXPECT_GE(most_hidden, 3U);
 }
 
+// A board hides the left part of the case from the first frame on (the
+// paper's assumption that the first frame sees the whole object is broken):
+// the case is presumed to go on behind it, in its plane, so the hidden part
+// is in the problem and is recognised as soon as it comes into view.
+TEST(Perception, AnObjectCutFromTheStartGoesOnBehindTheOccluder) {
+  PerceptionSettings on;
+  PerceptionSettings off = on;
+  off.behind_occluders = false;
+  Perception presume{on};
+  Perception seen_only{off};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  test::SyntheticScene cut = test::table_and_case();
+  cut.shapes.push_back(test::make_box({-0.08, -0.2, 0.07}, {0.12, 0.01, 0.3}, {230, 230, 230}, test::kOther));
+  const Frame f0 = render(cut, wMc);
+  const PerceptionResult r = presume.process(f0.frame);
+  const PerceptionResult r_off = seen_only.process(f0.frame);
+  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  ASSERT_EQ(r_off.status, TrackingStatus::Initialised) << r_off.message;
+  EXPECT_EQ(r_off.counts.presumed_voxels, 0U);
+  EXPECT_EQ(r_off.counts.hidden_vertices, 0U);
+  ASSERT_GE(r.counts.hidden_vertices, 3U);
+  // In the plane of the front face, and over the hidden left part (the
+  // board hides x < -0.02 or so; the seen part starts there).
+  const auto n = static_cast<Eigen::Index>(r.counts.hidden_vertices);
+  const Eigen::Index cols = r.problem.positions.cols();
+  double leftmost = 0.0;
+  for (Eigen::Index i = cols - n; i < cols; ++i) {
+    EXPECT_NEAR(r.problem.positions(1, i), kFrontFace.y(), 0.006) << "vertex " << i;
+    leftmost = std::min(leftmost, r.problem.positions(0, i));
+  }
+  EXPECT_LT(leftmost, -0.08);
+  // The centroid moves towards the whole case's.
+  EXPECT_LT(std::abs(r.centroid.x() - kFrontFace.x()), std::abs(r_off.centroid.x() - kFrontFace.x()));
+
+  // The board leaves: the whole case is object at once, and nothing of what
+  // was presumed beyond it stays.
+  const Frame f1 = render(test::table_and_case(), wMc);
+  const PerceptionResult r1 = presume.process(f1.frame);
+  const PerceptionResult r1_off = seen_only.process(f1.frame);
+  const auto score = test::score_object(r1, test::supervoxel_truth(r1, f1.frame, f1.labels), kObject);
+  const auto score_off = test::score_object(r1_off, test::supervoxel_truth(r1_off, f1.frame, f1.labels), kObject);
+  EXPECT_GE(score.recall, 0.9);
+  EXPECT_GE(score.precision, 0.95);
+  EXPECT_LT(score_off.recall, score.recall);
+  EXPECT_EQ(r1.counts.hidden_vertices, 0U);
+  EXPECT_EQ(r1.counts.presumed_voxels, 0U);
+
+  // Nothing is presumed for an object the first frame sees whole.
+  Perception whole{on};
+  EXPECT_EQ(whole.process(f1.frame).counts.presumed_voxels, 0U);
+  const PerceptionResult later = whole.process(f0.frame);
+  EXPECT_EQ(later.counts.presumed_voxels, 0U);
+
+  // Nor for one seen through a cage: bars cut more of what is seen than
+  // its own outline shows, and the seen strips tell too little of the rest.
+  test::SyntheticScene caged = test::table_and_case();
+  for (const double x : {-0.05, 0.0, 0.05}) {
+    caged.shapes.push_back(test::make_box({x, -0.2, 0.07}, {0.02, 0.01, 0.3}, {110, 110, 120}, test::kOther));
+  }
+  Perception cage{on};
+  const PerceptionResult rc = cage.process(render(caged, wMc).frame);
+  ASSERT_EQ(rc.status, TrackingStatus::Initialised) << rc.message;
+  EXPECT_EQ(rc.counts.presumed_voxels, 0U);
+}
+
 TEST(Perception, BoxAndImageSelectionsPickTheCase) {
   const Eigen::Isometry3d wMc = test::front_camera();
   test::SyntheticScene scene = test::table_and_case();

@@ -143,6 +143,19 @@ struct PerceptionSettings {
   /// the part of the arm it cannot see. false: only what the frame shows
   /// (the paper's reading).
   bool beyond_view = true;
+  /// The paper assumes the first frame sees the whole object. When an
+  /// occluder (nearer the camera than obb_margin) cuts the object's outline
+  /// in the first frame, on no more of it than the object's own outline
+  /// shows (one side cut, not an object seen through a cage), the object
+  /// is presumed to go on behind it: from each cut the plane of the seen
+  /// surface is continued, voxel by voxel and across the line of sight,
+  /// while something nearer the camera (not the support plane) hides it and
+  /// at most as far as the seen part is wide. Those voxels join the memory
+  /// as hidden (vertices of the problem, part of C and the OBB), are
+  /// recognised as object when they come into view and dropped when a
+  /// frame shows them not there. Ends once a frame shows the object with no
+  /// such cut. false: only what has been seen (the paper's reading).
+  bool behind_occluders = true;
   ObjectSelection selection;
 };
 
@@ -192,6 +205,7 @@ struct PerceptionCounts {
   std::size_t object_voxels = 0;  ///< seen in this frame
   std::size_t hidden_voxels = 0;  ///< remembered behind occluders, added to the object cloud
   std::size_t hidden_vertices = 0;  ///< vertices of the remembered hidden voxels added to the problem (hidden_vertices)
+  std::size_t presumed_voxels = 0;  ///< voxels presumed behind an occluder this frame (PerceptionSettings::behind_occluders)
 };
 
 /// \brief Wall time of each stage [ms].

@@ -194,6 +194,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     if (setup.perception == PerceptionMode::Full && !perception) {
       PerceptionSettings settings = perception_settings(loop.estimator());
       settings.beyond_view = setup.loop.beyond_view;
+      settings.behind_occluders = setup.loop.behind_occluders;
       if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.labels);
       perception.emplace(settings);
     }

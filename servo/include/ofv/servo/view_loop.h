@@ -89,6 +89,8 @@ struct LoopSettings {
   /// The front end's PerceptionSettings::beyond_view, where the loop makes
   /// the front end (simulation with perception=full, ofv::run_on_robot).
   bool beyond_view = true;
+  /// The front end's PerceptionSettings::behind_occluders, likewise.
+  bool behind_occluders = true;
   AnticipationSettings anticipation;
   TrackerSettings tracker;           ///< the occluder tracks anticipation uses
   NoFreeViewSettings no_free_view;   ///< what to do when the estimator finds no free view
