@@ -93,9 +93,9 @@ struct Perception::Impl {
   // foreign voxels of a mixed boundary supervoxel (a hand's, the table's)
   // never become object and cannot pull their neighbours in next frame.
   std::vector<char> voxel_matched;
-  // object_motion(): the frame's object voxels (hashed) and normals, and the
-  // voxels on the object's own outline with the outline's outward normal,
-  // of this frame and of the previous one.
+  // object_motion(): the frame's object voxels (hashed), normals and
+  // chromaticities, and the voxels on the object's own outline with the
+  // outline's outward normal, of this frame and of the previous one.
   std::vector<Eigen::Vector3f> moved;
   std::vector<Eigen::Vector3f> moved_normals;
   detail::PointGrid moved_grid;
@@ -167,6 +167,7 @@ struct Perception::Impl {
   /// object_memory.cpp: the object's rigid motion from the previous frame
   /// to this one (world frame), from its visible voxels matched against the
   /// memory; identity when it cannot be told (TrackingSettings::follow_motion).
+  /// Also finds the frame's outline and its cuts (`cuts`).
   Eigen::Isometry3d object_motion(const RgbdFrame& frame, const PerceptionResult& r,
                                   const std::vector<char>& object);
   /// object_memory.cpp: the memory updated with the frame's object; its
