@@ -82,6 +82,19 @@ TEST(Metrics, HiddenFromTheStartWithoutAnEntryHasNoWarning) {
   EXPECT_FALSE(m.occlusions[0].occluder_entered);
 }
 
+TEST(Metrics, TheSensorsWarningIsWhenTheOccluderCameIntoView) {
+  // In the sphere from 0.1 s, in the image from 0.3 s, hiding from 0.4 s.
+  auto steps = episode({1, 1, 1, 1, 0.5, 1, 1}, {0, 1, 1, 1, 1, 1, 1});
+  for (std::size_t k = 3; k < steps.size(); ++k) steps[k].occluders_in_view = 1;
+  const EpisodeMetrics m = summarise(steps);
+  ASSERT_EQ(m.occlusions.size(), 1U);
+  EXPECT_NEAR(*m.occlusions[0].occluder_entered, 0.1, 1e-12);
+  EXPECT_NEAR(*m.occlusions[0].occluder_in_view, 0.3, 1e-12);
+  // Seen from the first frame: no warning to speak of.
+  for (auto& s : steps) s.occluders_in_view = 1;
+  EXPECT_FALSE(summarise(steps).occlusions[0].occluder_in_view);
+}
+
 TEST(Metrics, EmptyAndSingleStepEpisodes) {
   EXPECT_EQ(summarise({}).steps, 0);
   const EpisodeMetrics one = summarise(episode({0.7}, {0}));

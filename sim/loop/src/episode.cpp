@@ -82,6 +82,7 @@ ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const E
   ViewProblem gt_problem = renderer.ground_truth_problem(rec.wMc, estimator.r_seed, r_sphere);
   rec.visible_fraction = truth.visible_fraction;
   rec.occluders_in_sphere = truth.occluders_in_sphere;
+  rec.occluders_in_view = truth.occluders_in_view;
   rec.sphere_distance_error = (rec.wMc.translation() - truth.centroid).norm() - r_sphere;
   const Eigen::Vector3d gt_centroid =
       gt_problem.positions.cols() > 0 ? Eigen::Vector3d(gt_problem.positions.rowwise().mean()) : truth.centroid;

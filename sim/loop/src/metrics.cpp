@@ -78,11 +78,16 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
   m.mean_times.control /= n;
   m.status_counts.assign(statuses.begin(), statuses.end());
 
-  // When the occluder count in the sphere last rose, at or before each step.
-  std::vector<std::optional<double>> entered(steps.size());
-  for (std::size_t k = 1; k < steps.size(); ++k) {
-    entered[k] = steps[k].occluders_in_sphere > steps[k - 1].occluders_in_sphere ? steps[k].time : entered[k - 1];
-  }
+  // When a count last rose, at or before each step.
+  const auto last_rise = [&steps](int StepRecord::*count) {
+    std::vector<std::optional<double>> rose(steps.size());
+    for (std::size_t k = 1; k < steps.size(); ++k) {
+      rose[k] = steps[k].*count > steps[k - 1].*count ? steps[k].time : rose[k - 1];
+    }
+    return rose;
+  };
+  const auto entered = last_rise(&StepRecord::occluders_in_sphere);
+  const auto in_view = last_rise(&StepRecord::occluders_in_view);
   // Occlusion events: the visibility falls below the threshold, until it is
   // back for `hold` seconds.
   for (std::size_t k = 0; k < steps.size(); ++k) {
@@ -90,6 +95,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
     OcclusionEvent event;
     event.onset = steps[k].time;
     event.occluder_entered = entered[k];
+    event.occluder_in_view = in_view[k];
     std::size_t j = k + 1;  // the first step of a visible run that lasts `hold`
     while (j < steps.size()) {
       if (steps[j].visible_fraction < threshold) {
@@ -130,6 +136,25 @@ std::string episode_summary(const EpisodeMetrics& m) {
     } else {
       out << "never (" << m.unrecovered_occlusions << " still hidden at the end)";
     }
+    // The warning before each onset, as the sensor and as the sphere gave it.
+    const auto mean_lead = [&m](std::optional<double> OcclusionEvent::*since) -> std::optional<double> {
+      double sum = 0.0;
+      int n = 0;
+      for (const auto& e : m.occlusions) {
+        if (!(e.*since)) continue;
+        sum += e.onset - *(e.*since);
+        ++n;
+      }
+      return n > 0 ? std::optional<double>(sum / n) : std::nullopt;
+    };
+    const auto in_view = mean_lead(&OcclusionEvent::occluder_in_view);
+    const auto entered = mean_lead(&OcclusionEvent::occluder_entered);
+    if (in_view || entered) {
+      out << "\n  warning before an onset (mean): ";
+      if (in_view) out << "occluder in view " << *in_view << " s";
+      if (in_view && entered) out << ", ";
+      if (entered) out << "in the sphere " << *entered << " s";
+    }
   }
   out << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path " << m.path_length
       << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
@@ -142,7 +167,7 @@ std::string episode_summary(const EpisodeMetrics& m) {
 
 std::string trajectory_csv_header() {
   return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,targetx,targety,targetz,status,safety,iterations,"
-         "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,tracks,fastest_track_speed,"
+         "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,occluders_in_view,tracks,fastest_track_speed,"
          "predicted_occluders,"
          "render_s,perception_s,estimate_s,control_s";
 }
@@ -167,7 +192,7 @@ std::string trajectory_csv_row(const StepRecord& s) {
   vec(s.target);
   out << to_string(s.status) << ',' << to_string(s.safety) << ',' << s.iterations << ',' << s.visible_fraction << ','
       << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
-      << ',' << s.tracks << ',' << s.fastest_track_speed << ',' << s.predicted_occluders << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
+      << ',' << s.occluders_in_view << ',' << s.tracks << ',' << s.fastest_track_speed << ',' << s.predicted_occluders << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
       << s.times.control;
   return out.str();
 }

@@ -33,7 +33,8 @@ json metrics_to_json(const EpisodeMetrics& m) {
   for (const auto& e : m.occlusions) {
     occlusions.push_back({{"onset_s", e.onset},
                           {"recovery_time_s", optional_json(e.recovery_time)},
-                          {"occluder_entered_s", optional_json(e.occluder_entered)}});
+                          {"occluder_entered_s", optional_json(e.occluder_entered)},
+                          {"occluder_in_view_s", optional_json(e.occluder_in_view)}});
   }
   json statuses = json::object();
   for (const auto& [status, count] : m.status_counts) statuses[status] = count;
@@ -70,6 +71,7 @@ EpisodeMetrics metrics_from_json(const json& j) {
     ev.onset = e.at("onset_s").get<double>();
     if (!e.at("recovery_time_s").is_null()) ev.recovery_time = e.at("recovery_time_s").get<double>();
     if (!e.at("occluder_entered_s").is_null()) ev.occluder_entered = e.at("occluder_entered_s").get<double>();
+    if (!e.at("occluder_in_view_s").is_null()) ev.occluder_in_view = e.at("occluder_in_view_s").get<double>();
     m.occlusions.push_back(ev);
   }
   if (!j.at("max_recovery_time_s").is_null()) m.max_recovery_time = j.at("max_recovery_time_s").get<double>();

@@ -44,6 +44,7 @@ struct StepRecord {
   double sphere_distance_error = 0.0; ///< |camera - true centroid| - r_sphere [m]
   Eigen::Vector3d true_centroid = Eigen::Vector3d::Zero();  ///< the object's surface centroid [m]
   int occluders_in_sphere = 0;        ///< ground truth: occluders inside the sphere
+  int occluders_in_view = 0;          ///< ground truth: occluders the sensor sees (sim::ObjectTruth)
   int tracks = 0;                     ///< confirmed occluder tracks seen this frame
   double fastest_track_speed = 0.0;   ///< largest speed among them [m/s]
   int predicted_occluders = 0;        ///< predicted occluder points the target was chosen against
@@ -58,6 +59,10 @@ struct OcclusionEvent {
   /// [s]: the warning the loop had. None when no occluder entered (one was
   /// there from the start, or the object left the image).
   std::optional<double> occluder_entered;
+  /// When the count of occluders the sensor sees last rose, at or before the
+  /// onset [s]: the warning full perception could have had. None when no
+  /// occluder came into view (one was seen from the start).
+  std::optional<double> occluder_in_view;
 };
 
 /// \brief Summary of an episode.
