@@ -237,6 +237,7 @@ struct Frame {
   double max_depth = 0.0;
   double visible_fraction = 0.0;
   int occluders_in_sphere = 0;
+  int occluders_in_view = 0;
   std::vector<std::string> files;
 };
 
@@ -331,6 +332,7 @@ Frame render(const py::object& scenario_obj, double time, const py::object& pose
   f.max_depth = scenario.sensor.max_depth;
   f.visible_fraction = truth.visible_fraction;
   f.occluders_in_sphere = truth.occluders_in_sphere;
+  f.occluders_in_view = truth.occluders_in_view;
   return f;
 }
 
@@ -500,6 +502,7 @@ released while it runs: Python threads can run episodes in parallel.
       .def_readonly("max_depth", &Frame::max_depth, "the sensor's range [m]")
       .def_readonly("visible_fraction", &Frame::visible_fraction, "ground truth: fraction of the object's surface seen")
       .def_readonly("occluders_in_sphere", &Frame::occluders_in_sphere, "ground truth: occluders within r_sphere of the object")
+      .def_readonly("occluders_in_view", &Frame::occluders_in_view, "ground truth: occluders the sensor sees")
       .def_readonly("files", &Frame::files, "PNG files written (when out was given)")
       .def("__repr__", [](const Frame& f) {
         return "Frame(" + std::to_string(f.depth.shape(1)) + "x" + std::to_string(f.depth.shape(0)) + " at t=" +

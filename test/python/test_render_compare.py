@@ -39,6 +39,8 @@ def test_render_arrays_are_the_pictures():
     assert np.all(frame.labels[frame.depth == 0.0] == ofv.LABEL_NONE)
     np.testing.assert_array_equal(frame.wMc, ofv.load_scenario("dvd-one-hand").wMc_start)
     assert frame.occluders_in_sphere >= 0 and 0.0 < frame.visible_fraction <= 1.0
+    occluders = np.unique(frame.labels[frame.labels >= ofv.LABEL_OCCLUDER0])
+    assert frame.occluders_in_view == len(occluders)
     del matplotlib
 
 
