@@ -357,15 +357,15 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
     if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) return false;
     return !impl_->occluded(o, w.p);
   };
-  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
+  const auto object = static_cast<std::size_t>(impl_->object);
   int facing = 0, visible = 0;
-  for (const auto& s : impl_->samples[static_cast<std::size_t>(impl_->object)]) {
-    const WorldPoint w = at(m, s);
+  for (const auto& s : impl_->samples[object]) {
+    const WorldPoint w = at(impl_->world[object], s);
     t.centroid += w.p;
     facing += w.n.dot(o - w.p) > 0.0 ? 1 : 0;
     visible += seen(w) ? 1 : 0;
   }
-  t.centroid /= static_cast<double>(impl_->samples[static_cast<std::size_t>(impl_->object)].size());
+  t.centroid /= static_cast<double>(impl_->samples[object].size());
   t.visible_fraction = facing > 0 ? static_cast<double>(visible) / facing : 0.0;
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     if (scenario_.bodies[b].role != Role::Occluder) continue;
