@@ -63,15 +63,21 @@ cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d, const std::vec
 
 // Visibility and distance error over time, drawn by gnuplot, run in `dir`
 // without a shell: the script names its files relative to `dir`, so the
-// folder's name (the user's --out) appears nowhere.
+// folder's name (the user's --out) appears nowhere. Two bands along the
+// bottom show when an occluder is in the sphere and when the sensor sees one.
 bool plot_visibility(const fs::path& dir) {
   std::ofstream gp(dir / "visibility.gp");
-  gp << "set terminal pngcairo size 900,420 font 'Sans,10'\nset output 'visibility.png'\n"
+  gp << "set terminal pngcairo size 900,460 font 'Sans,10'\nset output 'visibility.png'\n"
         "set datafile separator ','\nset grid\nset xlabel 'time [s]'\nset ylabel 'visible fraction'\n"
         "set y2label 'distance to the sphere [cm]'\nset ytics nomirror\nset y2tics\nset yrange [0:1.05]\n"
-        "set key bottom right\nplot 'trajectory.csv' using \"time\":\"visible_fraction\" with lines lw 2 "
-        "title 'true visible fraction', '' using \"time\":(100*column(\"sphere_distance_error\")) axes x1y2 "
-        "with lines title 'distance error [cm]'\n";
+        "set key below\nset style fill transparent solid 0.5 noborder\n"
+        "plot 'trajectory.csv' using \"time\":(0):(column(\"occluders_in_sphere\") > 0 ? 0.04 : 0) "
+        "with filledcurves lc rgb '#999999' title 'occluder in the sphere', "
+        "'' using \"time\":(0.04):(column(\"occluders_in_view\") > 0 ? 0.08 : 0.04) "
+        "with filledcurves lc rgb '#e66101' title 'occluder in view', "
+        "'' using \"time\":\"visible_fraction\" with lines lw 2 lc rgb '#5e3c99' title 'true visible fraction', "
+        "'' using \"time\":(100*column(\"sphere_distance_error\")) axes x1y2 with lines lc rgb '#1b9e77' "
+        "title 'distance error [cm]'\n";
   gp.close();
   return gp && detail::run_gnuplot(dir, "visibility.gp", {});
 }
