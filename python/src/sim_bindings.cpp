@@ -332,7 +332,7 @@ Frame render(const py::object& scenario_obj, double time, const py::object& pose
   f.max_depth = scenario.sensor.max_depth;
   f.visible_fraction = truth.visible_fraction;
   f.occluders_in_sphere = truth.occluders_in_sphere;
-  f.occluders_in_view = truth.occluders_in_view;
+  f.occluders_in_view = sim::occluders_seen(r.labels);
   return f;
 }
 

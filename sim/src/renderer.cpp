@@ -344,29 +344,25 @@ void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing,
 
 ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {
   ObjectTruth t;
+  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
+  const auto& samples = impl_->samples[static_cast<std::size_t>(impl_->object)];
   const Eigen::Vector3d o = wMc.translation();
   const Eigen::Isometry3d cMw = wMc.inverse();
   const CameraIntrinsics& k = scenario_.sensor.intrinsics;
-  // The sensor sees `w`: it faces the camera, is in range and in the image,
-  // and nothing nearer hides it.
-  const auto seen = [&](const WorldPoint& w) {
-    if (w.n.dot(o - w.p) <= 0.0) return false;
-    const Eigen::Vector3d pc = cMw * w.p;
-    if (pc.z() < scenario_.sensor.min_depth || pc.z() > scenario_.sensor.max_depth) return false;
-    const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
-    if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) return false;
-    return !impl_->occluded(o, w.p);
-  };
-  const auto object = static_cast<std::size_t>(impl_->object);
-  int facing = 0, visible = 0;
-  for (const auto& s : impl_->samples[object]) {
-    const WorldPoint w = at(impl_->world[object], s);
+  int facing = 0, seen = 0;
+  for (const auto& s : samples) {
+    const WorldPoint w = at(m, s);
     t.centroid += w.p;
-    facing += w.n.dot(o - w.p) > 0.0 ? 1 : 0;
-    visible += seen(w) ? 1 : 0;
+    if (w.n.dot(o - w.p) <= 0.0) continue;
+    ++facing;
+    const Eigen::Vector3d pc = cMw * w.p;
+    if (pc.z() < scenario_.sensor.min_depth || pc.z() > scenario_.sensor.max_depth) continue;
+    const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
+    if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
+    if (!impl_->occluded(o, w.p)) ++seen;
   }
-  t.centroid /= static_cast<double>(impl_->samples[object].size());
-  t.visible_fraction = facing > 0 ? static_cast<double>(visible) / facing : 0.0;
+  t.centroid /= static_cast<double>(samples.size());
+  t.visible_fraction = facing > 0 ? static_cast<double>(seen) / facing : 0.0;
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     if (scenario_.bodies[b].role != Role::Occluder) continue;
     const auto& verts = impl_->world[b].vertices;
@@ -374,12 +370,23 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
       return (v.cast<double>() - t.centroid).norm() < r_sphere;
     });
     t.occluders_in_sphere += inside ? 1 : 0;
-    const auto& samples = impl_->samples[b];
-    const bool in_view = std::any_of(samples.begin(), samples.end(),
-                                     [&](const SurfaceSample& s) { return seen(at(impl_->world[b], s)); });
-    t.occluders_in_view += in_view ? 1 : 0;
   }
   return t;
+}
+
+int occluders_seen(const std::vector<std::uint16_t>& labels) {
+  std::vector<bool> seen;
+  int count = 0;
+  for (const std::uint16_t label : labels) {
+    if (label < kLabelOccluder0) continue;
+    const std::size_t k = label - kLabelOccluder0;
+    if (k >= seen.size()) seen.resize(k + 1, false);
+    if (!seen[k]) {
+      seen[k] = true;
+      ++count;
+    }
+  }
+  return count;
 }
 
 ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double r_seed,

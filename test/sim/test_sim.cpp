@@ -1,5 +1,6 @@
 // The simulated world: scenario files, motion, deformation, rendering against
 // analytic depth, labels, ground-truth visibility, determinism.
+#include "ofv/sim/live_source.h"
 #include "ofv/sim/renderer.h"
 #include "ofv/constants.h"
 
@@ -7,7 +8,6 @@
 
 #include <cmath>
 #include <limits>
-#include <set>
 
 namespace ofv::sim {
 namespace {
@@ -308,36 +308,31 @@ TEST(Truth, VisibleFractionOnHandComputedCases) {
   }
 }
 
-TEST(Truth, OccludersInViewAreThoseTheSensorSees) {
-  // In front of the wall, beside the field of view, behind the wall, behind the camera.
-  Renderer r(wall_scene(0.6,
-                        "occluders: [{shape: box, size: [0.05, 0.05, 0.02], position: [0, 0, 0.3]},\n"
-                        "            {shape: box, size: [0.05, 0.05, 0.02], position: [2.0, 0, 0.3]},\n"
-                        "            {shape: box, size: [0.05, 0.05, 0.02], position: [0, 0, 0.7]},\n"
-                        "            {shape: box, size: [0.05, 0.05, 0.02], position: [0, 0, -0.3]}]"));
-  const ObjectTruth t = r.truth(r.scenario().wMc_start, 1.0);
-  EXPECT_EQ(t.occluders_in_view, 1);
-  EXPECT_EQ(t.occluders_in_sphere, 3);  // within 1 m of the wall: all but the one 2 m aside
+// In front of the wall, beside the field of view, behind the wall, behind the camera.
+Scenario four_occluders() {
+  return wall_scene(0.6,
+                    "occluders: [{shape: box, size: [0.05, 0.05, 0.02], position: [0, 0, 0.3]},\n"
+                    "            {shape: box, size: [0.05, 0.05, 0.02], position: [2.0, 0, 0.3]},\n"
+                    "            {shape: box, size: [0.05, 0.05, 0.02], position: [0, 0, 0.7]},\n"
+                    "            {shape: box, size: [0.05, 0.05, 0.02], position: [0, 0, -0.3]}]");
 }
 
-// The count agrees with the labels of the noise-free image as a hand comes in.
-TEST(Truth, OccludersInViewMatchTheRenderedLabels) {
-  Scenario s = load_scenario("dvd-one-hand");
-  s.sensor.noise.enabled = false;
-  Renderer r(s);
-  int seen_at_some_time = 0;
-  for (const double time : {0.0, 1.0, 1.4, 1.6, 2.0, 3.0}) {
-    r.set_time(time);
-    const RenderedFrame f = r.render(s.wMc_start, 0);
-    std::set<std::uint16_t> occluders;
-    for (const std::uint16_t label : f.labels) {
-      if (label >= kLabelOccluder0) occluders.insert(label);
-    }
-    const int in_view = r.truth(s.wMc_start, 0.5).occluders_in_view;
-    EXPECT_EQ(in_view, static_cast<int>(occluders.size())) << "at t = " << time;
-    seen_at_some_time = std::max(seen_at_some_time, in_view);
-  }
-  EXPECT_GE(seen_at_some_time, 1);
+TEST(Truth, OccludersSeenAreThoseTheFrameShows) {
+  Renderer r(four_occluders());
+  EXPECT_EQ(occluders_seen(r.render(r.scenario().wMc_start, 0).labels), 1);
+  EXPECT_EQ(r.truth(r.scenario().wMc_start, 1.0).occluders_in_sphere, 3);  // all but the one 2 m aside
+  EXPECT_EQ(occluders_seen({}), 0);
+  EXPECT_EQ(occluders_seen({kLabelObject, kLabelOccluder0 + 3, kLabelBackground, kLabelOccluder0 + 3,
+                            kLabelOccluder0}), 2);
+}
+
+TEST(LiveSource, KeepsTheLabelsOfItsLastFrame) {
+  Renderer r(four_occluders());
+  LiveSource source(r, [&r] { return r.scenario().wMc_start; }, 10.0);
+  const std::optional<RgbdFrame> frame = source.next();
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(source.labels().size(), frame->depth.size());
+  EXPECT_EQ(occluders_seen(source.labels()), 1);
 }
 
 TEST(Truth, GroundTruthProblemFacesTheCamera) {

@@ -82,7 +82,6 @@ ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const E
   ViewProblem gt_problem = renderer.ground_truth_problem(rec.wMc, estimator.r_seed, r_sphere);
   rec.visible_fraction = truth.visible_fraction;
   rec.occluders_in_sphere = truth.occluders_in_sphere;
-  rec.occluders_in_view = truth.occluders_in_view;
   rec.sphere_distance_error = (rec.wMc.translation() - truth.centroid).norm() - r_sphere;
   const Eigen::Vector3d gt_centroid =
       gt_problem.positions.cols() > 0 ? Eigen::Vector3d(gt_problem.positions.rowwise().mean()) : truth.centroid;
@@ -187,6 +186,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     rec.times.render = seconds_since(start);
 
     ViewProblem gt_problem = record_truth(rec, renderer, loop.estimator());
+    rec.occluders_in_view = sim::occluders_seen(rendered.labels);
 
     start = Clock::now();
     std::optional<ViewProblem> problem;
@@ -262,6 +262,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;
     (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
+    rec.occluders_in_view = sim::occluders_seen(source.labels());
     rec.times.render = f.source_s;
     rec.times.perception = f.perception_s;
     record_step(rec, *f.step);

@@ -40,11 +40,11 @@ struct ObjectTruth {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< area-weighted surface centroid [m]
   double visible_fraction = 0.0;  ///< fraction of the surface the camera sees [0, 1]
   int occluders_in_sphere = 0;    ///< occluders with a vertex within r_sphere of the centroid
-  /// Occluders the sensor sees: a camera-facing surface sample in its depth
-  /// range, in the image and not hidden by anything nearer. With full
-  /// perception nothing earlier can warn the loop of an occluder.
-  int occluders_in_view = 0;
 };
+
+/// \brief The occluders a rendered frame shows (distinct occluder labels):
+///        with full perception nothing earlier can warn the loop of one.
+[[nodiscard]] int occluders_seen(const std::vector<std::uint16_t>& labels);
 
 /**
  * \brief Renders one scenario. set_time() rebuilds the moving and deforming

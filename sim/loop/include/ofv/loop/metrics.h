@@ -44,7 +44,7 @@ struct StepRecord {
   double sphere_distance_error = 0.0; ///< |camera - true centroid| - r_sphere [m]
   Eigen::Vector3d true_centroid = Eigen::Vector3d::Zero();  ///< the object's surface centroid [m]
   int occluders_in_sphere = 0;        ///< ground truth: occluders inside the sphere
-  int occluders_in_view = 0;          ///< ground truth: occluders the sensor sees (sim::ObjectTruth)
+  int occluders_in_view = 0;          ///< ground truth: occluders the rendered frame shows
   int tracks = 0;                     ///< confirmed occluder tracks seen this frame
   double fastest_track_speed = 0.0;   ///< largest speed among them [m/s]
   int predicted_occluders = 0;        ///< predicted occluder points the target was chosen against
