@@ -50,7 +50,7 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_option("--robot", opt->robot, "camera (free-flying), viper850 or afma6 (default: the scenario's)");
   sub->add_option("--set", opt->sets, "Override a setting: name=value (repeatable; the settings are listed below)")
       ->type_name("NAME=VALUE");
-  sub->add_option("--perception", opt->perception, "full (PCL front end, default) or ground-truth (the simulator's supervoxels)");
+  sub->add_option("--perception", opt->perception, "full (the front end, default), labels (the same with the rendered labels in place of segmentation and classification) or ground-truth (the simulator's supervoxels and every occluder in the sphere)");
   sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
   sub->add_option("--out", opt->out, "Output folder (default: out/simulate/SCENARIO)");
   sub->add_flag("!--no-pictures", opt->pictures, "Skip the PNG pictures");

@@ -39,6 +39,18 @@ inline constexpr double kTumDepthFactor = 5000.0;
   return static_cast<float>(units) * static_cast<float>(1.0 / factor);
 }
 
+/**
+ * \brief What a pixel shows, in the label images of the simulator and of
+ *        ofv's own recordings (RgbdFrame::labels).
+ */
+enum PixelLabel : std::uint16_t {
+  kPixelNone = 0,         ///< nothing (no surface within the sensor's range)
+  kPixelObject = 1,       ///< the tracked object
+  kPixelInteracting = 2,  ///< what holds the object (a body the scene declares interacting)
+  kPixelSupport = 3,      ///< the support the object stands on (a table)
+  kPixelOccluder0 = 10,   ///< occluding body k is kPixelOccluder0 + k
+};
+
 /// \brief Depth, colour and pose of one frame. Images are row-major, width x height.
 struct RgbdFrame {
   double timestamp = 0.0;       ///< [s] since the start of the episode or recording
@@ -46,6 +58,9 @@ struct RgbdFrame {
   std::vector<float> depth;     ///< Z depth [m] per pixel; 0 or NaN where missing
   std::vector<std::uint8_t> rgb;  ///< 3 bytes per pixel, R G B
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< camera pose in the world
+  /// Ground truth where the source knows it (the simulator, ofv's own
+  /// recordings): a PixelLabel per pixel; empty for a real sensor.
+  std::vector<std::uint16_t> labels;
 
   /// Index of pixel (u, v) in `depth`; multiply by 3 for `rgb`.
   [[nodiscard]] std::size_t index(int u, int v) const {

@@ -322,7 +322,7 @@ Frame render(const py::object& scenario_obj, double time, const py::object& pose
   py::array_t<std::uint8_t> colour({h, w, py::ssize_t{3}});
   std::copy(r.frame.rgb.begin(), r.frame.rgb.end(), colour.mutable_data());
   py::array_t<std::uint16_t> labels({h, w});
-  std::copy(r.labels.begin(), r.labels.end(), labels.mutable_data());
+  std::copy(r.frame.labels.begin(), r.frame.labels.end(), labels.mutable_data());
   f.depth = depth;
   f.colour = colour;
   f.labels = labels;
@@ -332,7 +332,7 @@ Frame render(const py::object& scenario_obj, double time, const py::object& pose
   f.max_depth = scenario.sensor.max_depth;
   f.visible_fraction = truth.visible_fraction;
   f.occluders_in_sphere = truth.occluders_in_sphere;
-  f.occluders_in_view = sim::occluders_seen(r.labels);
+  f.occluders_in_view = sim::occluders_seen(r.frame.labels);
   return f;
 }
 

@@ -17,6 +17,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
   if (!options.problem_source) {
     PerceptionSettings front_end = perception_settings(loop.estimator());
     front_end.selection = options.selection;
+    front_end.classes = options.classes;
     front_end.beyond_view = settings.beyond_view;
     front_end.behind_occluders = settings.behind_occluders;
     perception.emplace(front_end);

@@ -128,11 +128,11 @@ SettingsTable<LoopSettings> make_table() {
         [](L& l, const std::string& v) { l.controller.target_filter = parse_number("target_filter", v, 0.0, 10.0, false); },
         [](const L& l) { return format_number(l.controller.target_filter); });
   t.add({"beyond_view", "bool", format_bool(d.beyond_view), "",
-         "perception=full: an occluder the image border cuts goes on beyond it, to the sphere (false: only what the frame shows)"},
+         "the front end (perception full or labels): an occluder the image border cuts goes on beyond it, to the sphere (false: only what the frame shows)"},
         [](L& l, const std::string& v) { l.beyond_view = parse_bool("beyond_view", v); },
         [](const L& l) { return format_bool(l.beyond_view); });
   t.add({"behind_occluders", "bool", format_bool(d.behind_occluders), "",
-         "perception=full: when an occluder cuts the object in the first frame, the object goes on behind it (false: only what has been seen)"},
+         "the front end (perception full or labels): when an occluder cuts the object in the first frame, the object goes on behind it (false: only what has been seen)"},
         [](L& l, const std::string& v) { l.behind_occluders = parse_bool("behind_occluders", v); },
         [](const L& l) { return format_bool(l.behind_occluders); });
   t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",

@@ -16,7 +16,6 @@ std::optional<RgbdFrame> LiveSource::next() {
   RenderedFrame rendered = renderer_.render(wMc, index_++);
   rendered.frame.timestamp = t;
   rendered.frame.wMc = wMc;
-  labels_ = std::move(rendered.labels);
   return std::move(rendered.frame);
 }
 

@@ -106,6 +106,7 @@ struct Renderer::Impl {
   RTCScene scene = nullptr;
   std::vector<TriangleMesh> world;               // per body, at the current time
   std::vector<std::uint16_t> labels;             // per body
+  std::vector<double> dropout;                   // per label: Body::dropout
   std::vector<std::vector<SurfaceSample>> samples;  // per body
   int object = 0;
 
@@ -141,6 +142,8 @@ Renderer::Renderer(const Scenario& scenario, int surface_samples)
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
     const Body& b = scenario_.bodies[k];
     impl_->labels.push_back(label_of(b, b.role == Role::Occluder ? occluder++ : 0));
+    if (impl_->dropout.size() <= impl_->labels.back()) impl_->dropout.resize(impl_->labels.back() + 1u, 0.0);
+    impl_->dropout[impl_->labels.back()] = std::max(impl_->dropout[impl_->labels.back()], b.dropout);
     if (b.role == Role::Object) impl_->object = static_cast<int>(k);
     const int n = b.role == Role::Object ? surface_samples
                                          : std::clamp(static_cast<int>(b.mesh.area() / (0.004 * 0.004)), 200, 20000);
@@ -204,7 +207,7 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
   const auto pixels = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
   f.depth.assign(pixels, 0.0f);
   f.rgb.assign(3 * pixels, 0);
-  out.labels.assign(pixels, kLabelNone);
+  f.labels.assign(pixels, kLabelNone);
   // Scratch kept by each thread that calls render, so a loop of frames
   // reuses it. (The workers below use the caller's, through these references.)
   thread_local std::vector<std::uint8_t> grazing_scratch;
@@ -268,7 +271,7 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
           const double c = std::abs(ng.normalized().dot(d.normalized()));
           f.depth[i] = rh.ray.tfar[j];
           grazing[i] = static_cast<float>(c) < cos_grazing ? 1 : 0;
-          out.labels[i] = impl_->labels[geom];
+          f.labels[i] = impl_->labels[geom];
           const Eigen::Vector3f colour = scenario_.bodies[geom].colour;
           const float shade = static_cast<float>(0.35 + 0.65 * c);
           for (int ch = 0; ch < 3; ++ch) {
@@ -332,7 +335,10 @@ void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing,
         }
         const double noise_z = gauss(rng) * m.depth_sigma * z * z;
         const double drop = uni(rng);
-        if (grazing[i] != 0 || (edge && drop < m.edge_dropout)) {
+        // A dark or shiny body's own drop-outs (drawn only for such a body,
+        // so the other scenarios' noise stays as it was).
+        const double dark = f.labels[i] < impl_->dropout.size() ? impl_->dropout[f.labels[i]] : 0.0;
+        if (grazing[i] != 0 || (edge && drop < m.edge_dropout) || (dark > 0.0 && uni(rng) < dark)) {
           f.depth[i] = 0.0f;
         } else {
           f.depth[i] = static_cast<float>(z + noise_z);
@@ -372,6 +378,14 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
     t.occluders_in_sphere += inside ? 1 : 0;
   }
   return t;
+}
+
+std::vector<Eigen::Vector3d> Renderer::object_surface() const {
+  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(impl_->samples[static_cast<std::size_t>(impl_->object)].size());
+  for (const auto& s : impl_->samples[static_cast<std::size_t>(impl_->object)]) points.push_back(at(m, s).p);
+  return points;
 }
 
 int occluders_seen(const std::vector<std::uint16_t>& labels) {

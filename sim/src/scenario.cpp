@@ -168,7 +168,7 @@ Motion motion(const Node& n, const std::string& base_dir) {
 
 Body body(const Node& n, Role role, const std::string& default_name, const std::string& base_dir) {
   n.require_map({"name", "shape", "size", "radius", "length", "thickness", "grid", "file", "scale",
-                 "colour", "position", "rpy_deg", "waypoints", "wave", "bend"});
+                 "colour", "position", "rpy_deg", "waypoints", "wave", "bend", "dropout"});
   Body b;
   b.role = role;
   b.name = n.has("name") ? n.child("name").word({}) : default_name;
@@ -220,6 +220,7 @@ Body body(const Node& n, Role role, const std::string& default_name, const std::
     if (w.has("length")) b.wave_length = w.child("length").positive(kMaxLength);
     if (w.has("frequency")) b.wave_frequency = w.child("frequency").in_range(0.0, 100.0);
   }
+  if (n.has("dropout")) b.dropout = n.child("dropout").in_range(0.0, 1.0);
   if (n.has("bend")) {
     if (b.shape != "cloth") n.child("bend").fail("only a cloth bends");
     b.bend = n.child("bend").in_range(-100.0, 100.0);

@@ -120,6 +120,7 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
   for (std::size_t i = 0; i < memory.size(); ++i) {
     if (memory_age[i] > 0) {
       object_cloud.push_back(memory[i].cast<double>());
+      r.hidden.push_back(memory[i]);
     }
   }
   r.counts.hidden_voxels = object_cloud.size() - r.counts.object_voxels;
@@ -131,7 +132,11 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
   r.axes = axes;
   r.obb = augmented_obb(object_cloud, c, axes, settings.obb_margin);
 
-  // Labels (paper II-B) and the estimator's input.
+  // Labels (paper II-B) and the estimator's input. Classes::Labels: the
+  // frame's labels of each supervoxel (supervoxel_labels) for the bodies.
+  const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
+  const std::vector<std::uint16_t>& truth = supervoxel_labels;
+  const auto is_body = [](std::uint16_t label) { return label == kPixelInteracting || label >= kPixelOccluder0; };
   std::vector<int> vertices;
   std::vector<int> occluders;
   for (std::size_t i = 0; i < n; ++i) {
@@ -142,7 +147,18 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
       if (s.normal_valid) {
         vertices.push_back(static_cast<int>(i));
       }
-    } else if (!settings.support_plane_occludes && on_plane(s)) {
+    } else if (labelled && is_body(truth[i])) {
+      // Classes::Labels: the holder and the occluding bodies as labelled.
+      const bool occluder = truth[i] != kPixelInteracting && (s.centroid - c).norm() < settings.r_sphere;
+      s.label = truth[i] == kPixelInteracting ? SupervoxelClass::Interacting
+                : occluder                    ? SupervoxelClass::Occluder
+                                              : SupervoxelClass::Background;
+      if (s.label == SupervoxelClass::Interacting) ++r.counts.interacting;
+      if (occluder) {
+        ++r.counts.occluders;
+        occluders.push_back(static_cast<int>(i));
+      }
+    } else if (!settings.support_plane_occludes && (labelled ? truth[i] == kPixelSupport : on_plane(s))) {
       s.label = SupervoxelClass::Background;
     } else if (r.obb.contains(s.centroid)) {
       s.label = SupervoxelClass::Interacting;

@@ -35,6 +35,10 @@ void check_frame(const RgbdFrame& frame) {
     text << "RgbdFrame: wMc is not a rigid transform within " << kMaxLength << " m of the origin:\n" << m;
     throw std::invalid_argument(text.str());
   }
+  if (!frame.labels.empty() && frame.labels.size() != n) {
+    throw std::invalid_argument("RgbdFrame: labels has " + std::to_string(frame.labels.size()) +
+                                " values, expected " + std::to_string(n) + " (or none)");
+  }
   if (!frame.rgb.empty() && frame.rgb.size() != 3 * n) {
     throw std::invalid_argument("RgbdFrame: rgb has " + std::to_string(frame.rgb.size()) +
                                 " bytes, expected " + std::to_string(3 * n) + " (or none)");

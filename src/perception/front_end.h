@@ -88,6 +88,8 @@ struct Perception::Impl {
   detail::PointGrid grid;  // for adjacency and tracking
   std::vector<Eigen::Vector3f> centroids;
   std::vector<Eigen::Vector3d> object_cloud;  // classify(): visible + hidden object voxels
+  // Classes::Labels: the frame's label of each supervoxel (split_by_labels()).
+  std::vector<std::uint16_t> supervoxel_labels;
   // Per voxel of the current frame: may it enter the object state? In
   // tracking only voxels that matched the state themselves do, so the
   // foreign voxels of a mixed boundary supervoxel (a hand's, the table's)
@@ -158,6 +160,15 @@ struct Perception::Impl {
   /// object_selection.cpp: the first frame's object supervoxels (1 = object);
   /// fits the support plane and sets voxel_matched. `why` says why none is found.
   std::vector<char> select(const RgbdFrame& frame, const PerceptionResult& r, std::string& why);
+  /// object_selection.cpp: the support plane (a plane holding a fifth of the
+  /// cloud, RANSAC) and its colour; supervoxels on it are never object.
+  void fit_support_plane(const PerceptionResult& r);
+  /// labelled.cpp (Classes::Labels): every supervoxel cut where the frame's
+  /// labels change; supervoxel_labels holds each piece's label.
+  void split_by_labels(const RgbdFrame& frame);
+  /// labelled.cpp (Classes::Labels): the supervoxels labelled object (the
+  /// first frame also fits the support plane); sets voxel_matched.
+  std::vector<char> labelled_object(const PerceptionResult& r);
   /// object_memory.cpp: a later frame's object supervoxels, those near the
   /// remembered object voxels; sets voxel_matched.
   std::vector<char> track(const PerceptionResult& r);

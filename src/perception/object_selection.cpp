@@ -207,11 +207,8 @@ std::vector<char> select_cluster(const RgbdFrame& frame, const PerceptionResult&
 
 }  // namespace
 
-std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const PerceptionResult& r,
-                                           std::string& why) {
+void Perception::Impl::fit_support_plane(const PerceptionResult& r) {
   const std::size_t n = r.supervoxels.size();
-  // The support plane: a plane holding at least a fifth of the points. Its
-  // supervoxels are never object, whatever the selection.
   const auto min_inliers = static_cast<std::size_t>(0.2 * static_cast<double>(cloud.points.size()));
   plane = detail::fit_dominant_plane(cloud.points, settings.tracking.plane_distance,
                                      std::max<std::size_t>(min_inliers, 3));
@@ -227,6 +224,13 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
     plane_chroma = count > 0 ? Eigen::Vector3f(sum / static_cast<float>(count))
                              : Eigen::Vector3f::Constant(-10.0f);  // matches no colour
   }
+}
+
+std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const PerceptionResult& r,
+                                           std::string& why) {
+  const std::size_t n = r.supervoxels.size();
+  // The support plane: its supervoxels are never object, whatever the selection.
+  fit_support_plane(r);
   std::vector<char> off_plane(n);
   for (std::size_t i = 0; i < n; ++i) {
     off_plane[i] = on_plane(r.supervoxels[i]) ? 0 : 1;

@@ -5,6 +5,7 @@
 #include "front_end.h"
 
 #include <chrono>
+#include <stdexcept>
 #include <string>
 
 namespace ofv {
@@ -22,6 +23,10 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   const auto start = std::chrono::steady_clock::now();
   PerceptionResult r;
   r.wMc = frame.wMc;
+  if (settings.classes == PerceptionSettings::Classes::Labels && frame.labels.empty()) {
+    throw std::invalid_argument("perception with classes from labels needs frames that carry labels (the "
+                                "simulator's, ofv's own recordings); this frame has none");
+  }
 
   // 1. Cloud: crop to the sphere around the last centroid (or the user box).
   auto stage = std::chrono::steady_clock::now();
@@ -44,6 +49,8 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   // 2. Supervoxels, and the R_adj graph between them.
   stage = std::chrono::steady_clock::now();
   detail::cluster_supervoxels(cloud, settings.supervoxels, frame.wMc.translation(), sv);
+  const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
+  if (labelled) split_by_labels(frame);
   r.supervoxels = sv.supervoxels;
   r.voxels = sv.voxels;
   r.voxel_owner = sv.owner;
@@ -57,7 +64,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   // 3. The object: selected in the first frame, tracked afterwards; then remembered.
   stage = std::chrono::steady_clock::now();
   std::string why;
-  const std::vector<char> object = initialised ? track(r) : select(frame, r, why);
+  const std::vector<char> object = labelled ? labelled_object(r) : initialised ? track(r) : select(frame, r, why);
   set_status(r, object, why);
   if (r.status != TrackingStatus::Lost) {
     remember(frame, r, object);

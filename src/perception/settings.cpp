@@ -24,6 +24,10 @@ const char* to_string(TrackingStatus status) {
   return "?";
 }
 
+const char* to_string(PerceptionSettings::Classes classes) {
+  return classes == PerceptionSettings::Classes::Labels ? "labels" : "segmentation";
+}
+
 const char* to_string(SupervoxelClass label) {
   switch (label) {
     case SupervoxelClass::Object:

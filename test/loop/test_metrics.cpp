@@ -1,5 +1,6 @@
 // Episode metrics on hand-made step sequences.
 #include "ofv/loop/metrics.h"
+#include "ofv/loop/metrics_json.h"
 
 #include <gtest/gtest.h>
 
@@ -108,6 +109,48 @@ TEST(Metrics, TrajectoryRowMatchesTheHeader) {
   s.status = StepStatus::Converged;
   const auto count = [](const std::string& line) { return std::count(line.begin(), line.end(), ','); };
   EXPECT_EQ(count(trajectory_csv_row(s)), count(trajectory_csv_header()));
+}
+
+// Perception scores: means over the frames that have them, the worst with
+// its time, the worst where at least half of the object is in view; lost
+// frames with the object half in view are counted.
+TEST(Metrics, PerceptionScoresSummariseOverTheFramesThatHaveThem) {
+  auto steps = episode({1.0, 0.4, 0.8, 0.9, 1.0}, {0, 1, 1, 1, 0});
+  const std::vector<std::optional<double>> precision{1.0, 0.5, 0.9, std::nullopt, 0.95};
+  const std::vector<std::optional<double>> recall{1.0, 0.6, 0.8, 0.0, 1.0};
+  const std::vector<std::optional<double>> error{0.01, 0.04, 0.02, std::nullopt, 0.01};
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    steps[k].perception.object_precision = precision[k];
+    steps[k].perception.object_recall = recall[k];
+    steps[k].perception.centroid_error = error[k];
+  }
+  const EpisodeMetrics m = summarise(steps);
+  const PerceptionSummary& p = m.perception;
+  ASSERT_TRUE(p.scored());
+  EXPECT_EQ(p.object_precision.frames, 4);
+  EXPECT_NEAR(*p.object_precision.mean, (1.0 + 0.5 + 0.9 + 0.95) / 4, 1e-12);
+  EXPECT_EQ(*p.object_precision.worst, 0.5);
+  EXPECT_NEAR(p.object_precision.worst_time, 0.1, 1e-12);
+  EXPECT_EQ(*p.object_precision.worst_half_visible, 0.9);  // 0.5 was with 0.4 in view
+  EXPECT_EQ(*p.object_recall.worst, 0.0);
+  EXPECT_EQ(*p.centroid_error.worst, 0.04);  // errors: the largest is the worst
+  EXPECT_EQ(*p.centroid_error.worst_half_visible, 0.02);
+  EXPECT_EQ(p.lost_half_visible, 1);  // t = 0.3: recall 0, no centroid, 0.9 in view
+  EXPECT_FALSE(p.occluder_recall.mean);
+  EXPECT_EQ(p.occluder_recall.frames, 0);
+
+  // metrics.json keeps the block; an episode without scores has none.
+  const EpisodeMetrics back = metrics_from_json(metrics_to_json(m));
+  EXPECT_EQ(back.perception.object_precision.frames, 4);
+  EXPECT_EQ(*back.perception.object_precision.worst_half_visible, 0.9);
+  EXPECT_EQ(*back.perception.centroid_error.worst, 0.04);
+  EXPECT_FALSE(back.perception.occluder_recall.worst);
+  EXPECT_EQ(back.perception.lost_half_visible, 1);
+  EXPECT_TRUE(metrics_to_json(summarise(episode({1.0}, {0})))["perception"].is_null());
+
+  // trajectory.csv: the scores last, empty where there is none.
+  const std::string row = trajectory_csv_row(steps[3]);
+  EXPECT_EQ(row.substr(row.size() - 7), ",,0,,,,");
 }
 
 }  // namespace

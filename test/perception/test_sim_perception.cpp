@@ -1,6 +1,7 @@
 // The front end against the simulator's ground truth (ofv::sim renderer,
 // built-in scenarios with sensor noise).
 #include "ofv/perception/perception.h"
+#include "ofv/perception/scores.h"
 #include "ofv/sim/renderer.h"
 #include "ofv/sim/scenario.h"
 
@@ -44,7 +45,7 @@ EpisodeStats run_scenario(const std::string& name, double until) {
     renderer.set_time(k / scenario.rate);
     const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
     const RgbdFrame& frame = rendered.frame;
-    const std::vector<int> labels(rendered.labels.begin(), rendered.labels.end());
+    const std::vector<int> labels(rendered.frame.labels.begin(), rendered.frame.labels.end());
     const PerceptionResult r = perception.process(frame);
     ++s.frames;
     if (r.status == TrackingStatus::Lost) {
@@ -194,7 +195,7 @@ TEST(SimPerception, HiddenObjectSupervoxelsStayInTheProblem) {
           const int y = v + dv;
           if (x < 0 || y < 0 || x >= in.width || y >= in.height || du * du + dv * dv > reach * reach) continue;
           const std::size_t i = rendered.frame.index(x, y);
-          unseen = rendered.labels[i] >= sim::kLabelOccluder0 || !(rendered.frame.depth[i] > 0.0f);
+          unseen = rendered.frame.labels[i] >= sim::kLabelOccluder0 || !(rendered.frame.depth[i] > 0.0f);
         }
       }
       EXPECT_TRUE(unseen) << "a remembered vertex in plain sight: " << p.transpose();
@@ -220,6 +221,62 @@ TEST(SimPerception, RecordedEpisodesPlayBackThroughPerceive) {
   const CommandRun bad = run("record no-such-scenario --out /tmp/ofv_never");
   EXPECT_EQ(bad.code, 2);
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1);
+}
+
+}  // namespace
+}  // namespace ofv
+
+namespace ofv {
+namespace {
+
+// Classes::Labels is a perfect classifier of the sensor's frames: on every
+// frame of a scene with a holder, an entering hand and the table, what it
+// calls object and occluder is object and occluder (precision 1 by the
+// scores' own definition), it finds what the frame shows of both, and the
+// same frames without labels are refused.
+TEST(SimPerception, LabelsModeIsAPerfectClassifierOfTheFrame) {
+  const sim::Scenario scenario = sim::load_scenario("dvd-one-hand");
+  sim::Renderer renderer(scenario);
+  PerceptionSettings settings;
+  settings.classes = PerceptionSettings::Classes::Labels;
+  Perception perception(settings);
+  int occluded_frames = 0;
+  for (int k = 0; k < static_cast<int>(2.5 * scenario.rate); ++k) {
+    renderer.set_time(k / scenario.rate);
+    const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
+    const PerceptionResult r = perception.process(rendered.frame);
+    ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k;
+    PerceptionTruth truth;
+    truth.centroid = renderer.truth(scenario.wMc_start, settings.r_sphere).centroid;
+    truth.r_sphere = settings.r_sphere;
+    truth.surface = renderer.object_surface();
+    const PerceptionScores s = score_perception(rendered.frame, r, truth, settings);
+    EXPECT_DOUBLE_EQ(*s.object_precision, 1.0) << "frame " << k;
+    EXPECT_GE(*s.object_recall, 0.98) << "frame " << k;
+    if (s.occluder_precision) {
+      EXPECT_DOUBLE_EQ(*s.occluder_precision, 1.0) << "frame " << k;
+    }
+    if (s.occluder_recall && s.occluder_cells >= 20) {
+      ++occluded_frames;
+      EXPECT_GE(*s.occluder_recall, 0.95) << "frame " << k;
+    }
+    // The holder is never an occluder, the support only by the paper's rule.
+    for (const SupervoxelInfo& sv : r.supervoxels) {
+      if (sv.label == SupervoxelClass::Occluder) {
+        EXPECT_LT((sv.centroid - r.centroid).norm(), settings.r_sphere);
+      }
+    }
+    if (s.hidden_error) {
+      EXPECT_LT(*s.hidden_error, 0.01) << "frame " << k;
+    }
+  }
+  EXPECT_GT(occluded_frames, 0) << "the hand never came into the sphere";
+
+  renderer.set_time(0.0);
+  sim::RenderedFrame unlabelled = renderer.render(scenario.wMc_start, 0);
+  unlabelled.frame.labels.clear();
+  Perception fresh(settings);
+  EXPECT_THROW((void)fresh.process(unlabelled.frame), std::invalid_argument);
 }
 
 }  // namespace

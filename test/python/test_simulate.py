@@ -58,9 +58,16 @@ def test_episode_equals_the_command_lines(tmp_path, run_cli, perception, duratio
     episode = ofv.simulate("dvd-one-hand", perception=perception, duration=duration, **sets)
     _assert_same_episode(episode, tmp_path / "cli")
     assert episode.out == "" and episode.files == []
-    assert episode.metrics["perception"] == perception
+    assert episode.metrics["perception"]["mode"] == perception
     if perception == "full":
         assert np.nanmax(episode.trajectory["tracks"]) >= 1
+        # Every frame of the front end scored against the rendered labels.
+        assert np.all(np.isfinite(episode.trajectory["object_recall"]))
+        assert episode.metrics["perception"]["object_precision"]["frames"] == episode.metrics["steps"]
+        assert episode.metrics["perception"]["object_precision"]["mean"] >= 0.98
+    else:
+        assert set(episode.metrics["perception"]) == {"mode"}
+        assert np.all(np.isnan(episode.trajectory["object_recall"]))
 
 
 def test_files_written_into_out_are_those_of_the_command_line(tmp_path):

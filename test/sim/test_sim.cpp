@@ -275,13 +275,13 @@ TEST(Renderer, LabelsNameWhatEachPixelSees) {
   auto label_at = [&](const Eigen::Vector3d& p) {
     const int u = static_cast<int>(std::lround(k.fx * p.x() / p.z() + k.cx));
     const int v = static_cast<int>(std::lround(k.fy * p.y() / p.z() + k.cy));
-    return f.labels[f.frame.index(u, v)];
+    return f.frame.labels[f.frame.index(u, v)];
   };
   EXPECT_EQ(label_at({0, 0, 0.5}), kLabelOccluder0);
   EXPECT_EQ(label_at({0.07, 0.05, 1.0}), kLabelObject);
   EXPECT_EQ(label_at({0.125, 0.0, 1.0}), kLabelInteracting);
   EXPECT_EQ(label_at({0.0, 0.29, 1.2}), kLabelBackground);
-  EXPECT_EQ(f.labels[f.frame.index(2, 2)], kLabelNone);
+  EXPECT_EQ(f.frame.labels[f.frame.index(2, 2)], kLabelNone);
   EXPECT_EQ(f.frame.depth[f.frame.index(2, 2)], 0.0f);
 }
 
@@ -319,20 +319,20 @@ Scenario four_occluders() {
 
 TEST(Truth, OccludersSeenAreThoseTheFrameShows) {
   Renderer r(four_occluders());
-  EXPECT_EQ(occluders_seen(r.render(r.scenario().wMc_start, 0).labels), 1);
+  EXPECT_EQ(occluders_seen(r.render(r.scenario().wMc_start, 0).frame.labels), 1);
   EXPECT_EQ(r.truth(r.scenario().wMc_start, 1.0).occluders_in_sphere, 3);  // all but the one 2 m aside
   EXPECT_EQ(occluders_seen({}), 0);
   EXPECT_EQ(occluders_seen({kLabelObject, kLabelOccluder0 + 3, kLabelBackground, kLabelOccluder0 + 3,
                             kLabelOccluder0}), 2);
 }
 
-TEST(LiveSource, KeepsTheLabelsOfItsLastFrame) {
+TEST(LiveSource, FramesCarryTheirLabels) {
   Renderer r(four_occluders());
   LiveSource source(r, [&r] { return r.scenario().wMc_start; }, 10.0);
   const std::optional<RgbdFrame> frame = source.next();
   ASSERT_TRUE(frame);
-  EXPECT_EQ(source.labels().size(), frame->depth.size());
-  EXPECT_EQ(occluders_seen(source.labels()), 1);
+  EXPECT_EQ(frame->labels.size(), frame->depth.size());
+  EXPECT_EQ(occluders_seen(frame->labels), 1);
 }
 
 TEST(Truth, GroundTruthProblemFacesTheCamera) {
@@ -360,10 +360,10 @@ TEST(Renderer, NoiseIsDeterministicPerFrame) {
   const RenderedFrame a = r.render(s.wMc_start, 30), b = r.render(s.wMc_start, 30), c = r.render(s.wMc_start, 31);
   EXPECT_EQ(a.frame.depth, b.frame.depth);
   EXPECT_NE(a.frame.depth, c.frame.depth);
-  EXPECT_EQ(a.labels, c.labels);  // labels are noise-free ground truth
+  EXPECT_EQ(a.frame.labels, c.frame.labels);  // labels are noise-free ground truth
   std::size_t missing = 0, valid = 0;  // on the object, seen face-on
   for (std::size_t i = 0; i < a.frame.depth.size(); ++i) {
-    if (a.labels[i] != kLabelObject) continue;
+    if (a.frame.labels[i] != kLabelObject) continue;
     ++valid;
     missing += a.frame.depth[i] == 0.0f ? 1 : 0;
   }
@@ -388,7 +388,7 @@ TEST(Renderer, AFrameRenderedIntoAnotherIsTheFrameRenderedAfresh) {
     r.render(s.wMc_start, 8, k, noise, reused);
     EXPECT_EQ(reused.frame.depth, fresh.frame.depth);
     EXPECT_EQ(reused.frame.rgb, fresh.frame.rgb);
-    EXPECT_EQ(reused.labels, fresh.labels);
+    EXPECT_EQ(reused.frame.labels, fresh.frame.labels);
     EXPECT_EQ(reused.frame.intrinsics.width, k.width);
   }
 }

@@ -156,6 +156,23 @@ struct PerceptionSettings {
   /// frame shows them not there. Ends once a frame shows the object with no
   /// such cut. false: only what has been seen (the paper's reading).
   bool behind_occluders = true;
+  /// Where the object and the classes come from.
+  enum class Classes {
+    /// The paper's front end: the object tracked from frame to frame, the
+    /// other supervoxels classified by the augmented OBB and the sphere.
+    Segmentation,
+    /// The frame's ground-truth labels (RgbdFrame::labels) in place of
+    /// segmentation and classification: each supervoxel is cut where the
+    /// labels change (VoxelLabels); the object is what is labelled object,
+    /// the occluders what belongs to an occluding body inside the sphere,
+    /// the holder what is labelled interacting; the support and unlabelled
+    /// points are classified by the paper's rule. Everything else (memory
+    /// of the hidden part, its motion, behind_occluders, beyond_view) is the
+    /// same front end. What a perfect classifier of this sensor's frames
+    /// would give: the limit of any front end from this sensor.
+    Labels,
+  };
+  Classes classes = Classes::Segmentation;
   ObjectSelection selection;
 };
 
@@ -233,6 +250,9 @@ struct PerceptionResult {
       Eigen::Matrix3d::Identity();  ///< e1, e2, e3 (columns), PCA of the object voxels
   OrientedBox obb;                  ///< the augmented OBB
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< pose of the camera that saw the frame
+  /// The remembered object voxels this frame does not show (behind
+  /// something, out of the image, presumed behind an occluder) [m].
+  std::vector<Eigen::Vector3f> hidden;
   PerceptionCounts counts;
   PerceptionTimings timings;
   std::string message;  ///< why the object is lost, when it is
@@ -244,6 +264,8 @@ struct PerceptionResult {
 
 [[nodiscard]] const char* to_string(TrackingStatus status);
 [[nodiscard]] const char* to_string(SupervoxelClass label);
+/// \brief The word of PerceptionSettings::Classes: segmentation, labels.
+[[nodiscard]] const char* to_string(PerceptionSettings::Classes classes);
 
 /// \brief Throws std::invalid_argument naming the setting and value when a
 /// setting is out of range (non-positive resolutions, alpha outside [1, 1.5], ...).

@@ -31,11 +31,14 @@ SettingsTable<EpisodeSetup> make_table() {
          "free-flying camera, or the arm on ViSP's kinematic model (threaded simulator with real_time)"},
         [](E& e, const std::string& v) { e.robot = parse_robot_kind(v); },
         [](const E& e) { return std::string(to_string(e.robot)); });
-  t.add({"perception", "full | ground-truth", to_string(d.perception), "",
-         "PCL front end on the frames, or the simulator's ground-truth supervoxels"},
+  t.add({"perception", "full | labels | ground-truth", to_string(d.perception), "",
+         "the front end on the frames; the same with the rendered labels in place of segmentation and classification "
+         "(the limit of any front end from this sensor); or the simulator's ground-truth supervoxels and every occluder "
+         "in the sphere"},
         [](E& e, const std::string& v) {
-          e.perception = parse_word<PerceptionMode>("perception", v,
-                                                    {{"full", PerceptionMode::Full}, {"ground-truth", PerceptionMode::GroundTruth}});
+          e.perception = parse_word<PerceptionMode>(
+              "perception", v,
+              {{"full", PerceptionMode::Full}, {"labels", PerceptionMode::Labels}, {"ground-truth", PerceptionMode::GroundTruth}});
         },
         [](const E& e) { return std::string(to_string(e.perception)); });
   t.add({"select", "labels | auto", to_string(d.select), "",
@@ -90,6 +93,25 @@ ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const E
   return gt_problem;
 }
 
+// The front end of an episode with full or labels perception.
+PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
+  PerceptionSettings settings = perception_settings(setup.loop.estimator.resolve());
+  settings.beyond_view = setup.loop.beyond_view;
+  settings.behind_occluders = setup.loop.behind_occluders;
+  if (setup.perception == PerceptionMode::Labels) settings.classes = PerceptionSettings::Classes::Labels;
+  return settings;
+}
+
+// The front end's output against the frame's labels and the object's true surface.
+PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, const StepRecord& rec,
+                       const sim::Renderer& renderer, const PerceptionSettings& settings) {
+  PerceptionTruth truth;
+  truth.centroid = rec.true_centroid;
+  truth.r_sphere = settings.r_sphere;
+  truth.surface = renderer.object_surface();
+  return score_perception(frame, result, truth, settings);
+}
+
 // What the loop did.
 void record_step(StepRecord& rec, const LoopStep& step) {
   rec.times.estimate = step.estimate_s;
@@ -132,7 +154,14 @@ long episode_frames(const EpisodeSetup& setup) {
 
 }  // namespace
 
-const char* to_string(PerceptionMode mode) { return mode == PerceptionMode::Full ? "full" : "ground-truth"; }
+const char* to_string(PerceptionMode mode) {
+  switch (mode) {
+    case PerceptionMode::Full: return "full";
+    case PerceptionMode::Labels: return "labels";
+    case PerceptionMode::GroundTruth: return "ground-truth";
+  }
+  return "?";
+}
 const char* to_string(ObjectSelect select) { return select == ObjectSelect::Labels ? "labels" : "auto"; }
 
 const SettingsTable<EpisodeSetup>& episode_settings_table() {
@@ -186,28 +215,28 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     rec.times.render = seconds_since(start);
 
     ViewProblem gt_problem = record_truth(rec, renderer, loop.estimator());
-    rec.occluders_in_view = sim::occluders_seen(rendered.labels);
+    rec.occluders_in_view = sim::occluders_seen(rendered.frame.labels);
 
     start = Clock::now();
     std::optional<ViewProblem> problem;
     std::optional<double> shown = rec.visible_fraction;  // ground truth: what the camera sees
     Eigen::Index beyond_view = 0;
-    if (setup.perception == PerceptionMode::Full && !perception) {
-      PerceptionSettings settings = perception_settings(loop.estimator());
-      settings.beyond_view = setup.loop.beyond_view;
-      settings.behind_occluders = setup.loop.behind_occluders;
-      if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.labels);
+    if (setup.perception != PerceptionMode::GroundTruth && !perception) {
+      PerceptionSettings settings = front_end_settings(setup);
+      if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.frame.labels);
       perception.emplace(settings);
     }
+    std::optional<PerceptionResult> result;
     if (perception) {
-      PerceptionResult result = perception->process(rendered.frame);
-      shown = shown_object(result);
-      beyond_view = static_cast<Eigen::Index>(result.counts.beyond_view);
-      if (result.status != TrackingStatus::Lost) problem = std::move(result.problem);
+      result = perception->process(rendered.frame);
+      shown = shown_object(*result);
+      beyond_view = static_cast<Eigen::Index>(result->counts.beyond_view);
+      if (result->status != TrackingStatus::Lost) problem = result->problem;
     } else {
       problem = std::move(gt_problem);
     }
     rec.times.perception = seconds_since(start);
+    if (result) rec.perception = score(rendered.frame, *result, rec, renderer, perception->settings());
 
     // The frame is as old as 1 + latency periods when its command is replaced.
     const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency), shown, beyond_view);
@@ -241,6 +270,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
   sim::LiveSource source(renderer, [&robot] { return to_eigen(robot->wMc()); }, setup.duration);
 
   RobotLoopOptions options;
+  options.classes = front_end_settings(setup).classes;
   options.wall_clock_age = true;
   options.first_period = 1.0 / setup.scenario.rate;
   options.stop = stop;
@@ -254,7 +284,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     const sim::SensorSettings& sensor = renderer.scenario().sensor;
     renderer.set_time(0.0);
     renderer.render(to_eigen(robot->wMc()), 0, sensor.intrinsics, sensor.noise.enabled, first);
-    options.selection = object_in(first.labels);
+    options.selection = object_in(first.frame.labels);
   }
   EpisodeOutcome outcome;
   (void)run_on_robot(source, *robot, setup.loop, options, [&](const RobotLoopFrame& f) {
@@ -262,7 +292,8 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;
     (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
-    rec.occluders_in_view = sim::occluders_seen(source.labels());
+    rec.occluders_in_view = sim::occluders_seen(f.frame->labels);
+    if (f.perception) rec.perception = score(*f.frame, *f.perception, rec, renderer, front_end_settings(setup));
     rec.times.render = f.source_s;
     rec.times.perception = f.perception_s;
     record_step(rec, *f.step);

@@ -164,7 +164,7 @@ std::vector<std::string> EpisodeWriter::finish(const EpisodeOutcome& outcome) {
   j["scenario"] = m.setup.scenario.name;
   j["method"] = to_string(m.setup.loop.method);
   j["robot"] = to_string(m.setup.robot);
-  j["perception"] = to_string(m.setup.perception);
+  j["perception"]["mode"] = to_string(m.setup.perception);  // beside the scores, if any
   std::ofstream(m.dir / "metrics.json") << j.dump(2) << '\n';
   std::vector<std::string> out{"trajectory.csv", "metrics.json"};
   if (m.files.pictures && plot_visibility(m.dir)) out.push_back("visibility.png");

@@ -84,7 +84,7 @@ std::vector<std::string> write_frame_pictures(const std::string& dir, const sim:
   coloured.setTo(cv::Scalar(0, 0, 0), depth <= 0.0f);
   cv::Mat labels(k.height, k.width, CV_8UC3);
   for (int v = 0; v < k.height; ++v) {
-    for (int u = 0; u < k.width; ++u) labels.at<cv::Vec3b>(v, u) = label_colour(r.labels[r.frame.index(u, v)]);
+    for (int u = 0; u < k.width; ++u) labels.at<cv::Vec3b>(v, u) = label_colour(r.frame.labels[r.frame.index(u, v)]);
   }
   write_png(fs::path(dir) / "colour.png", bgr);
   write_png(fs::path(dir) / "depth.png", coloured);

@@ -24,6 +24,44 @@ std::vector<double> step_durations(const std::vector<StepRecord>& steps) {
   return dt;
 }
 
+// One score over the steps: mean and worst (lowest when `higher_is_better`).
+ScoreSummary summarise_score(const std::vector<StepRecord>& steps, std::optional<double> PerceptionScores::*score,
+                             bool higher_is_better) {
+  ScoreSummary out;
+  double sum = 0.0;
+  const auto worse = [higher_is_better](double a, double b) { return higher_is_better ? a < b : a > b; };
+  for (const StepRecord& s : steps) {
+    const std::optional<double>& x = s.perception.*score;
+    if (!x) continue;
+    ++out.frames;
+    sum += *x;
+    if (!out.worst || worse(*x, *out.worst)) {
+      out.worst = *x;
+      out.worst_time = s.time;
+    }
+    if (s.visible_fraction >= 0.5 && (!out.worst_half_visible || worse(*x, *out.worst_half_visible))) {
+      out.worst_half_visible = *x;
+    }
+  }
+  if (out.frames > 0) out.mean = sum / out.frames;
+  return out;
+}
+
+PerceptionSummary summarise_perception(const std::vector<StepRecord>& steps) {
+  PerceptionSummary p;
+  p.object_precision = summarise_score(steps, &PerceptionScores::object_precision, true);
+  p.object_recall = summarise_score(steps, &PerceptionScores::object_recall, true);
+  p.occluder_precision = summarise_score(steps, &PerceptionScores::occluder_precision, true);
+  p.occluder_recall = summarise_score(steps, &PerceptionScores::occluder_recall, true);
+  p.centroid_error = summarise_score(steps, &PerceptionScores::centroid_error, false);
+  p.hidden_error = summarise_score(steps, &PerceptionScores::hidden_error, false);
+  for (const StepRecord& s : steps) {
+    const bool scored = s.perception.object_recall.has_value();
+    p.lost_half_visible += scored && !s.perception.centroid_error && s.visible_fraction >= 0.5 ? 1 : 0;
+  }
+  return p;
+}
+
 }  // namespace
 
 EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold, double hold) {
@@ -120,6 +158,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
     }
   }
   if (m.unrecovered_occlusions == 0) m.max_recovery_time = worst;
+  m.perception = summarise_perception(steps);
   return m;
 }
 
@@ -156,6 +195,26 @@ std::string episode_summary(const EpisodeMetrics& m) {
       if (entered) out << "in the sphere " << *entered << " s";
     }
   }
+  if (m.perception.scored()) {
+    const PerceptionSummary& p = m.perception;
+    const auto score = [&out](const char* name, const ScoreSummary& x, double scale = 1.0) {
+      out << name;
+      if (x.mean) {
+        out << ' ' << scale * *x.mean << " (worst " << scale * *x.worst << " at " << x.worst_time << " s)";
+      } else {
+        out << " -";
+      }
+    };
+    out << "\n  perception: ";
+    score("object precision", p.object_precision);
+    score(", recall", p.object_recall);
+    out << "\n              ";
+    score("occluder precision", p.occluder_precision);
+    score(", recall", p.occluder_recall);
+    out << "\n              ";
+    score("centroid error [cm]", p.centroid_error, 100.0);
+    score(", hidden part [cm]", p.hidden_error, 100.0);
+  }
   out << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path " << m.path_length
       << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
       << "  compute per step: " << 1e3 * m.mean_times.total() << " ms (render " << 1e3 * m.mean_times.render
@@ -169,7 +228,8 @@ std::string trajectory_csv_header() {
   return "time,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,t0x,t0y,t0z,tfx,tfy,tfz,targetx,targety,targetz,status,safety,iterations,"
          "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,occluders_in_view,tracks,fastest_track_speed,"
          "predicted_occluders,"
-         "render_s,perception_s,estimate_s,control_s";
+         "render_s,perception_s,estimate_s,control_s,"
+         "object_precision,object_recall,occluder_precision,occluder_recall,centroid_error,hidden_error";
 }
 
 std::string trajectory_csv_row(const StepRecord& s) {
@@ -194,6 +254,12 @@ std::string trajectory_csv_row(const StepRecord& s) {
       << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
       << ',' << s.occluders_in_view << ',' << s.tracks << ',' << s.fastest_track_speed << ',' << s.predicted_occluders << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
       << s.times.control;
+  for (const auto score : {&PerceptionScores::object_precision, &PerceptionScores::object_recall,
+                           &PerceptionScores::occluder_precision, &PerceptionScores::occluder_recall,
+                           &PerceptionScores::centroid_error, &PerceptionScores::hidden_error}) {
+    out << ',';
+    if (s.perception.*score) out << *(s.perception.*score);
+  }
   return out.str();
 }
 

@@ -1,6 +1,9 @@
 // EpisodeMetrics <-> JSON.
 #include "ofv/loop/metrics_json.h"
 
+#include <utility>
+#include <vector>
+
 namespace ofv {
 
 namespace {
@@ -24,6 +27,56 @@ StageTimes times_from_json(const json& j) {
 template <class T>
 json optional_json(const std::optional<T>& v) {
   return v ? json(*v) : json(nullptr);
+}
+
+json score_to_json(const ScoreSummary& s) {
+  return {{"frames", s.frames},
+          {"mean", optional_json(s.mean)},
+          {"worst", optional_json(s.worst)},
+          {"worst_time_s", s.worst_time},
+          {"worst_half_visible", optional_json(s.worst_half_visible)}};
+}
+
+std::optional<double> optional_from_json(const json& j) {
+  return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
+}
+
+ScoreSummary score_from_json(const json& j) {
+  ScoreSummary s;
+  s.frames = j.at("frames").get<int>();
+  s.mean = optional_from_json(j.at("mean"));
+  s.worst = optional_from_json(j.at("worst"));
+  s.worst_time = j.at("worst_time_s").get<double>();
+  s.worst_half_visible = optional_from_json(j.at("worst_half_visible"));
+  return s;
+}
+
+// The scores by their names in metrics.json.
+const std::vector<std::pair<const char*, ScoreSummary PerceptionSummary::*>>& perception_scores() {
+  static const std::vector<std::pair<const char*, ScoreSummary PerceptionSummary::*>> names{
+      {"object_precision", &PerceptionSummary::object_precision},
+      {"object_recall", &PerceptionSummary::object_recall},
+      {"occluder_precision", &PerceptionSummary::occluder_precision},
+      {"occluder_recall", &PerceptionSummary::occluder_recall},
+      {"centroid_error_m", &PerceptionSummary::centroid_error},
+      {"hidden_error_m", &PerceptionSummary::hidden_error}};
+  return names;
+}
+
+json perception_to_json(const PerceptionSummary& p) {
+  if (!p.scored()) return nullptr;
+  json j = {{"lost_half_visible_frames", p.lost_half_visible}};
+  for (const auto& [name, member] : perception_scores()) j[name] = score_to_json(p.*member);
+  return j;
+}
+
+PerceptionSummary perception_from_json(const json& j) {
+  PerceptionSummary p;
+  // null, or only the mode (`ofv simulate` adds it): nothing was scored.
+  if (!j.is_object() || !j.contains("lost_half_visible_frames")) return p;
+  p.lost_half_visible = j.at("lost_half_visible_frames").get<int>();
+  for (const auto& [name, member] : perception_scores()) p.*member = score_from_json(j.at(name));
+  return p;
 }
 
 }  // namespace
@@ -55,7 +108,8 @@ json metrics_to_json(const EpisodeMetrics& m) {
           {"mean_compute_time", times_to_json(m.mean_times)},
           {"max_compute_time", times_to_json(m.max_times)},
           {"estimator_iterations_max", m.estimator_iterations_max},
-          {"status_counts", statuses}};
+          {"status_counts", statuses},
+          {"perception", perception_to_json(m.perception)}};
 }
 
 EpisodeMetrics metrics_from_json(const json& j) {
@@ -74,7 +128,7 @@ EpisodeMetrics metrics_from_json(const json& j) {
     if (!e.at("occluder_in_view_s").is_null()) ev.occluder_in_view = e.at("occluder_in_view_s").get<double>();
     m.occlusions.push_back(ev);
   }
-  if (!j.at("max_recovery_time_s").is_null()) m.max_recovery_time = j.at("max_recovery_time_s").get<double>();
+  m.max_recovery_time = optional_from_json(j.at("max_recovery_time_s"));
   m.unrecovered_occlusions = j.at("unrecovered_occlusions").get<int>();
   m.mean_angular_error_deg = j.at("mean_angular_error_deg").get<double>();
   m.path_length = j.at("path_length_m").get<double>();
@@ -87,6 +141,8 @@ EpisodeMetrics metrics_from_json(const json& j) {
   for (const auto& [status, count] : j.at("status_counts").items()) {
     m.status_counts.emplace_back(status, count.get<int>());
   }
+  // Episodes written before the perception scores have none.
+  if (j.contains("perception")) m.perception = perception_from_json(j.at("perception"));
   return m;
 }
 

@@ -18,6 +18,8 @@ double t_quantile_95(int dof) {
   return dof <= 30 ? table[dof - 1] : 1.96;
 }
 
+double mean_score(const ScoreSummary& s) { return s.mean ? *s.mean : std::nan(""); }
+
 }  // namespace
 
 Interval mean_interval(const std::vector<double>& xs) {
@@ -59,6 +61,12 @@ const std::vector<MetricColumn>& metric_columns() {
       {"mean_estimate_ms", "estimate [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.mean_times.estimate; }},
       {"max_estimate_ms", "worst estimate [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.max_times.estimate; }},
       {"mean_step_ms", "whole step [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.mean_times.total(); }},
+      // Perception scores, means over the frames (n/a with ground-truth perception).
+      {"object_precision", "obj. precision", [](const EpisodeMetrics& m) { return mean_score(m.perception.object_precision); }},
+      {"object_recall", "obj. recall", [](const EpisodeMetrics& m) { return mean_score(m.perception.object_recall); }},
+      {"occluder_precision", "occl. precision", [](const EpisodeMetrics& m) { return mean_score(m.perception.occluder_precision); }},
+      {"occluder_recall", "occl. recall", [](const EpisodeMetrics& m) { return mean_score(m.perception.occluder_recall); }},
+      {"centroid_error_cm", "centroid err. [cm]", [](const EpisodeMetrics& m) { return 100.0 * mean_score(m.perception.centroid_error); }},
   };
   return c;
 }

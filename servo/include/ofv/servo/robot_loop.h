@@ -40,6 +40,9 @@ struct RobotLoopOptions {
   /// image rectangle or mask); the default is the front end's own choice,
   /// the cluster nearest the image centre.
   ObjectSelection selection;
+  /// Where perception's classes come from: the front end's segmentation,
+  /// or the frames' labels (frames that carry them: PerceptionSettings::Classes).
+  PerceptionSettings::Classes classes = PerceptionSettings::Classes::Segmentation;
   /// When set, the estimator's input comes from here instead of the
   /// perception front end (simulated ground truth); std::nullopt = lost.
   std::function<std::optional<ViewProblem>(const RgbdFrame&)> problem_source;

@@ -34,15 +34,12 @@ class LiveSource : public FrameSource {
   LiveSource(Renderer& renderer, PoseProvider pose, double duration);
   std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::string describe() const override;
-  /// \brief The ground-truth labels of the last frame next() returned.
-  [[nodiscard]] const std::vector<std::uint16_t>& labels() const { return labels_; }
 
  private:
   Renderer& renderer_;
   PoseProvider pose_;
   double duration_;
   long index_ = 0;
-  std::vector<std::uint16_t> labels_;
   std::optional<std::chrono::steady_clock::time_point> start_;
 };
 

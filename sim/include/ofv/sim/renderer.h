@@ -22,17 +22,16 @@ namespace ofv::sim {
 
 /// \brief Label image values.
 enum Label : std::uint16_t {
-  kLabelNone = 0,         ///< nothing hit (beyond the depth range)
-  kLabelObject = 1,
-  kLabelInteracting = 2,
-  kLabelBackground = 3,   ///< the table
-  kLabelOccluder0 = 10,   ///< occluder k is kLabelOccluder0 + k
+  kLabelNone = kPixelNone,                ///< nothing hit (beyond the depth range)
+  kLabelObject = kPixelObject,
+  kLabelInteracting = kPixelInteracting,
+  kLabelBackground = kPixelSupport,       ///< the table
+  kLabelOccluder0 = kPixelOccluder0,      ///< occluder k is kLabelOccluder0 + k
 };
 
-/// \brief A rendered frame and its ground-truth labels (width x height, row-major).
+/// \brief A rendered frame; its ground-truth labels are `frame.labels`.
 struct RenderedFrame {
   RgbdFrame frame;
-  std::vector<std::uint16_t> labels;
 };
 
 /// \brief Ground truth of the object at one time and camera pose.
@@ -79,6 +78,9 @@ class Renderer {
 
   /// \brief Object ground truth seen from a camera at `wMc` (r_sphere for the occluder count).
   [[nodiscard]] ObjectTruth truth(const Eigen::Isometry3d& wMc, double r_sphere) const;
+
+  /// \brief The object's surface samples (those of truth()) at the current time [m].
+  [[nodiscard]] std::vector<Eigen::Vector3d> object_surface() const;
 
   /**
    * \brief What perfect perception would give the estimator: object

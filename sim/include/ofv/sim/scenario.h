@@ -53,6 +53,9 @@ struct Body {
   Motion motion;
   /// Cloth only: travelling wave and bend along body x (see deform_sheet).
   double wave_amplitude = 0.0, wave_length = 0.2, wave_frequency = 0.0, bend = 0.0;
+  /// Probability that a pixel showing this body has no depth when the
+  /// sensor's noise is on: a dark or shiny surface [0, 1].
+  double dropout = 0.0;
   [[nodiscard]] bool deformable() const { return shape == "cloth"; }
   /// \brief The body's mesh in the world frame at time t.
   [[nodiscard]] TriangleMesh world_mesh(double t) const;

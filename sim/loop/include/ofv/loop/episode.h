@@ -27,10 +27,16 @@ namespace ofv {
 
 /// \brief Where the estimator's input comes from.
 enum class PerceptionMode {
-  Full,         ///< PCL front end on the rendered frame (needs ofv built with perception)
-  GroundTruth,  ///< the simulator's ground-truth supervoxels and occluders
+  Full,  ///< the front end on the rendered frame: what a robot gets
+  /// The same front end with the rendered labels in place of segmentation
+  /// and classification (PerceptionSettings::Classes::Labels): a perfect
+  /// classifier of this sensor's frames, the limit of any front end.
+  Labels,
+  /// The simulator's ground-truth supervoxels and every occluder in the
+  /// sphere, seen or not: beyond what the sensor shows.
+  GroundTruth,
 };
-/// \brief The mode's word in settings and files: full, ground-truth.
+/// \brief The mode's word in settings and files: full, labels, ground-truth.
 [[nodiscard]] const char* to_string(PerceptionMode mode);
 
 /// \brief How full perception finds the object in the first frame.

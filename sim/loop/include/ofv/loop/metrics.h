@@ -8,6 +8,7 @@
  */
 #pragma once
 
+#include "ofv/perception/scores.h"
 #include "ofv/servo/loop_status.h"
 
 #include <Eigen/Geometry>
@@ -48,7 +49,31 @@ struct StepRecord {
   int tracks = 0;                     ///< confirmed occluder tracks seen this frame
   double fastest_track_speed = 0.0;   ///< largest speed among them [m/s]
   int predicted_occluders = 0;        ///< predicted occluder points the target was chosen against
+  /// The front end's output against the frame's labels (ofv/perception/scores.h);
+  /// all empty when the estimator's input is the simulator's ground truth.
+  PerceptionScores perception;
   StageTimes times;                   ///< compute time of this step
+};
+
+/// \brief One perception score over an episode's frames (those where it is defined).
+struct ScoreSummary {
+  int frames = 0;               ///< frames where the score is defined
+  std::optional<double> mean;   ///< over those frames
+  std::optional<double> worst;  ///< lowest precision or recall, largest error
+  double worst_time = 0.0;      ///< when the worst was [s]
+  /// The worst over the frames where at least half of the object is in
+  /// view (true visible fraction >= 0.5), where the goals apply.
+  std::optional<double> worst_half_visible;
+};
+
+/// \brief The perception block of an episode (`metrics.json` "perception").
+struct PerceptionSummary {
+  ScoreSummary object_precision, object_recall, occluder_precision, occluder_recall;
+  ScoreSummary centroid_error;  ///< [m]
+  ScoreSummary hidden_error;    ///< [m]
+  /// Frames where the front end lost the object while the true visible fraction was at least 0.5.
+  int lost_half_visible = 0;
+  [[nodiscard]] bool scored() const { return object_recall.frames > 0; }
 };
 
 /// \brief One occlusion event: the visible fraction fell below the threshold.
@@ -85,6 +110,7 @@ struct EpisodeMetrics {
   StageTimes max_times;                 ///< worst step per stage [s]
   int estimator_iterations_max = 0;
   std::vector<std::pair<std::string, int>> status_counts;  ///< steps per status
+  PerceptionSummary perception;  ///< empty (scored() false) with ground-truth perception
 };
 
 /**

@@ -1,0 +1,197 @@
+// Perception scores against a frame's ground-truth labels (scores.h).
+#include "ofv/perception/scores.h"
+
+#include "ofv/perception/cloud.h"
+#include "point_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace ofv {
+
+namespace {
+
+Eigen::Vector3i cell_of(const Eigen::Vector3f& p, float inv_voxel) {
+  return (p * inv_voxel).array().floor().cast<int>();
+}
+
+std::optional<double> ratio(std::size_t part, std::size_t whole) {
+  if (whole == 0) return std::nullopt;
+  return static_cast<double>(part) / static_cast<double>(whole);
+}
+
+bool is_occluder(std::uint16_t label) { return label >= kPixelOccluder0; }
+
+// Distance from p to the nearest of `samples` (hashed in `grid`, cells of
+// `cell`); the whole set when none is within the 27 cells around p.
+double nearest_distance(const detail::PointGrid& grid, const std::vector<Eigen::Vector3f>& samples,
+                        const Eigen::Vector3f& p) {
+  float best = std::numeric_limits<float>::infinity();
+  grid.for_each_near(p, [&](int j) { best = std::min(best, (samples[static_cast<std::size_t>(j)] - p).squaredNorm()); });
+  if (!std::isfinite(best)) {
+    for (const Eigen::Vector3f& s : samples) best = std::min(best, (s - p).squaredNorm());
+  }
+  return std::sqrt(static_cast<double>(best));
+}
+
+}  // namespace
+
+VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, double max_depth) {
+  check_frame(frame);
+  if (frame.labels.empty()) {
+    throw std::invalid_argument("perception scores: the frame has no labels (only the simulator and ofv's "
+                                "own recordings carry them)");
+  }
+  if (!(voxel > 0.0) || stride < 1) {
+    throw std::invalid_argument("voxel labels: voxel " + std::to_string(voxel) + " m and stride " +
+                                std::to_string(stride) + ": expected a positive voxel and a stride >= 1");
+  }
+  inv_voxel_ = static_cast<float>(1.0 / voxel);
+  const CameraIntrinsics& k = frame.intrinsics;
+  const Eigen::Matrix3f wRc = frame.wMc.linear().cast<float>();
+  const Eigen::Vector3f wtc = frame.wMc.translation().cast<float>();
+  // Votes per cell: (label, count) pairs, a handful per cell at most.
+  std::vector<std::vector<std::pair<std::uint16_t, int>>> votes;
+  std::vector<int> counts;
+  for (int v = 0; v < k.height; v += stride) {
+    for (int u = 0; u < k.width; u += stride) {
+      const std::size_t i = frame.index(u, v);
+      const float z = frame.depth[i];
+      if (!(z > 0.0f) || !std::isfinite(z) || z > static_cast<float>(max_depth)) continue;
+      const Eigen::Vector3f pc(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
+      const Eigen::Vector3f pw = wRc * pc + wtc;
+      const auto [it, inserted] = index_.try_emplace(key(cell_of(pw, inv_voxel_)), static_cast<int>(cells_.size()));
+      if (inserted) {
+        cells_.emplace_back();
+        votes.emplace_back();
+        counts.push_back(0);
+      }
+      const auto c = static_cast<std::size_t>(it->second);
+      cells_[c].mean += pw;
+      ++counts[c];
+      auto& vote = votes[c];
+      const std::uint16_t label = frame.labels[i];
+      const auto found = std::find_if(vote.begin(), vote.end(), [label](const auto& x) { return x.first == label; });
+      if (found == vote.end()) {
+        vote.emplace_back(label, 1);
+      } else {
+        ++found->second;
+      }
+    }
+  }
+  for (std::size_t c = 0; c < cells_.size(); ++c) {
+    cells_[c].mean /= static_cast<float>(counts[c]);
+    // The most votes; a tie goes to the smaller label (deterministic).
+    const auto best = std::max_element(votes[c].begin(), votes[c].end(), [](const auto& a, const auto& b) {
+      return a.second < b.second || (a.second == b.second && a.first > b.first);
+    });
+    cells_[c].label = best->first;
+  }
+}
+
+std::uint64_t VoxelLabels::key(const Eigen::Vector3i& c) const {
+  const auto k = [](int x) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(x) + (std::int64_t{1} << 20)) & 0x1FFFFFu;
+  };
+  return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
+}
+
+int VoxelLabels::find(const Eigen::Vector3f& p) const {
+  const Eigen::Vector3i c = cell_of(p, inv_voxel_);
+  if (const auto it = index_.find(key(c)); it != index_.end()) return it->second;
+  int best = -1;
+  float best_d2 = std::numeric_limits<float>::infinity();
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const auto it = index_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+        if (it == index_.end()) continue;
+        const float d2 = (cells_[static_cast<std::size_t>(it->second)].mean - p).squaredNorm();
+        if (d2 < best_d2) {
+          best_d2 = d2;
+          best = it->second;
+        }
+      }
+    }
+  }
+  return best;
+}
+
+std::uint16_t VoxelLabels::label_at(const Eigen::Vector3f& p) const {
+  const int c = find(p);
+  return c < 0 ? std::uint16_t{kPixelNone} : cells_[static_cast<std::size_t>(c)].label;
+}
+
+PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult& result,
+                                  const PerceptionTruth& truth, const PerceptionSettings& settings) {
+  const VoxelLabels cells(frame, settings.supervoxels.voxel_resolution, settings.cloud.pixel_stride, settings.max_depth);
+  const std::vector<VoxelLabels::Cell>& all = cells.cells();
+  PerceptionScores s;
+  const auto r2 = static_cast<float>(truth.r_sphere * truth.r_sphere);
+  const Eigen::Vector3f centre = truth.centroid.cast<float>();
+  for (const VoxelLabels::Cell& c : all) {
+    s.object_cells += c.label == kPixelObject ? 1u : 0u;
+    s.occluder_cells += is_occluder(c.label) && (c.mean - centre).squaredNorm() < r2 ? 1u : 0u;
+  }
+
+  // Precision: each of the front end's voxels against its cell. Recall: a
+  // true cell is found when a voxel of the class lies within one voxel edge
+  // of its points' mean (PCL's voxels are re-gridded means: fewer than the cells).
+  std::vector<Eigen::Vector3f> object_points, occluder_points;
+  std::size_t object_voxels = 0, object_right = 0, occluder_voxels = 0, occluder_right = 0;
+  const bool lost = result.status == TrackingStatus::Lost;
+  for (std::size_t i = 0; i < result.voxels.size() && !lost; ++i) {
+    const SupervoxelClass cls = result.supervoxels[static_cast<std::size_t>(result.voxel_owner[i])].label;
+    if (cls != SupervoxelClass::Object && cls != SupervoxelClass::Occluder) continue;
+    const int c = cells.find(result.voxels[i]);
+    const std::uint16_t label = c < 0 ? std::uint16_t{kPixelNone} : all[static_cast<std::size_t>(c)].label;
+    if (cls == SupervoxelClass::Object) {
+      ++object_voxels;
+      object_right += label == kPixelObject ? 1u : 0u;
+      object_points.push_back(result.voxels[i]);
+    } else {
+      occluder_points.push_back(result.voxels[i]);
+      if (label == kPixelSupport) continue;
+      ++occluder_voxels;
+      occluder_right += is_occluder(label) ? 1u : 0u;
+    }
+  }
+  const double voxel = settings.supervoxels.voxel_resolution;
+  detail::PointGrid object_grid, occluder_grid;
+  object_grid.build(object_points, voxel);
+  occluder_grid.build(occluder_points, voxel);
+  const auto near = [voxel](const detail::PointGrid& grid, const Eigen::Vector3f& p) {
+    return grid.any_within(p, static_cast<float>(voxel), [](int) { return true; });
+  };
+  std::size_t object_found = 0, occluder_found = 0;
+  for (const VoxelLabels::Cell& c : all) {
+    object_found += c.label == kPixelObject && near(object_grid, c.mean) ? 1u : 0u;
+    occluder_found +=
+        is_occluder(c.label) && (c.mean - centre).squaredNorm() < r2 && near(occluder_grid, c.mean) ? 1u : 0u;
+  }
+  s.object_precision = ratio(object_right, object_voxels);
+  s.object_recall = ratio(object_found, s.object_cells);
+  s.occluder_precision = ratio(occluder_right, occluder_voxels);
+  s.occluder_recall = ratio(occluder_found, s.occluder_cells);
+  if (lost) return s;
+
+  s.centroid_error = (result.centroid - truth.centroid).norm();
+  if (!truth.surface.empty() && !result.hidden.empty()) {
+    std::vector<Eigen::Vector3f> samples;
+    samples.reserve(truth.surface.size());
+    for (const Eigen::Vector3d& p : truth.surface) samples.push_back(p.cast<float>());
+    detail::PointGrid grid;
+    grid.build(samples, settings.supervoxels.voxel_resolution);
+    double sum = 0.0;
+    for (const Eigen::Vector3f& p : result.hidden) sum += nearest_distance(grid, samples, p);
+    s.hidden_voxels = result.hidden.size();
+    s.hidden_error = sum / static_cast<double>(result.hidden.size());
+  }
+  return s;
+}
+
+}  // namespace ofv
