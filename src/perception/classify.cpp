@@ -132,6 +132,17 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
   r.axes = axes;
   r.obb = augmented_obb(object_cloud, c, axes, settings.obb_margin);
 
+  // Interacting: inside the augmented OBB and within obb_margin of the
+  // object's voxels. For a compact object that is the whole box; the empty
+  // part of the box of a bent or folded object (a hand in a cloth's
+  // hollow) holds no interacting element but occluders.
+  object_points.clear();
+  for (const Eigen::Vector3d& p : object_cloud) object_points.push_back(p.cast<float>());
+  object_grid.build(object_points, settings.obb_margin);
+  const auto near_object = [this](const Eigen::Vector3d& p) {
+    return object_grid.any_within(p.cast<float>(), static_cast<float>(settings.obb_margin), [](int) { return true; });
+  };
+
   // Labels (paper II-B) and the estimator's input. Classes::Labels: the
   // frame's labels of each supervoxel (supervoxel_labels) for the bodies.
   const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
@@ -160,7 +171,7 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
       }
     } else if (!settings.support_plane_occludes && (labelled ? truth[i] == kPixelSupport : on_plane(s))) {
       s.label = SupervoxelClass::Background;
-    } else if (r.obb.contains(s.centroid)) {
+    } else if (r.obb.contains(s.centroid) && near_object(s.centroid)) {
       s.label = SupervoxelClass::Interacting;
       ++r.counts.interacting;
     } else if ((s.centroid - c).norm() < settings.r_sphere) {

@@ -88,6 +88,8 @@ struct Perception::Impl {
   detail::PointGrid grid;  // for adjacency and tracking
   std::vector<Eigen::Vector3f> centroids;
   std::vector<Eigen::Vector3d> object_cloud;  // classify(): visible + hidden object voxels
+  std::vector<Eigen::Vector3f> object_points;  // the same, hashed in object_grid (interacting elements)
+  detail::PointGrid object_grid;
   // Classes::Labels: the frame's label of each supervoxel (split_by_labels()).
   std::vector<std::uint16_t> supervoxel_labels;
   // Per voxel of the current frame: may it enter the object state? In
