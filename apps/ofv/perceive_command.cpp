@@ -12,6 +12,8 @@
 #include "ofv/sources/openni2_source.h"
 
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -135,6 +137,18 @@ Command add_perceive_command(CLI::App& app) {
               std::cerr << "ofv perceive: " << source->describe() << ": " << summary.frames
                         << " frames, " << summary.lost << " lost, front end median "
                         << summary.median_front_end_ms << " ms\n";
+              if (summary.scored > 0) {
+                const auto show = [](const std::optional<double>& x, double scale = 1.0) {
+                  std::ostringstream text;
+                  text << std::fixed << std::setprecision(3) << scale * x.value_or(0.0);
+                  return x ? text.str() : std::string("n/a");
+                };
+                std::cerr << "ofv perceive: scores over " << summary.scored
+                          << " labelled frames (means): object precision " << show(summary.object_precision)
+                          << ", recall " << show(summary.object_recall) << "; occluder precision "
+                          << show(summary.occluder_precision) << ", recall " << show(summary.occluder_recall)
+                          << "; centroid error " << show(summary.centroid_error, 100.0) << " cm\n";
+              }
               return kOk;
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv perceive: " << e.what() << '\n';

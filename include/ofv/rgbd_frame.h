@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace ofv {
@@ -61,6 +62,9 @@ struct RgbdFrame {
   /// Ground truth where the source knows it (the simulator, ofv's own
   /// recordings): a PixelLabel per pixel; empty for a real sensor.
   std::vector<std::uint16_t> labels;
+  /// Ground truth where the source knows it: the object's surface centroid
+  /// in the world [m] (the simulator, ofv's own recordings).
+  std::optional<Eigen::Vector3d> object_centroid;
 
   /// Index of pixel (u, v) in `depth`; multiply by 3 for `rgb`.
   [[nodiscard]] std::size_t index(int u, int v) const {

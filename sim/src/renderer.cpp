@@ -208,6 +208,10 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
   f.depth.assign(pixels, 0.0f);
   f.rgb.assign(3 * pixels, 0);
   f.labels.assign(pixels, kLabelNone);
+  const std::vector<Eigen::Vector3d> surface = object_surface();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : surface) centroid += p;
+  f.object_centroid = centroid / static_cast<double>(std::max<std::size_t>(surface.size(), 1));
   // Scratch kept by each thread that calls render, so a loop of frames
   // reuses it. (The workers below use the caller's, through these references.)
   thread_local std::vector<std::uint8_t> grazing_scratch;

@@ -15,6 +15,16 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
   std::optional<Eigen::Vector3d> previous_view;
   PerceiveSummary summary;
   std::vector<double> front_end_ms;
+  // Sums and counts of each score over the scored frames.
+  constexpr int kScores = 5;
+  const std::optional<double> PerceptionScores::*score[kScores] = {
+      &PerceptionScores::object_precision, &PerceptionScores::object_recall, &PerceptionScores::occluder_precision,
+      &PerceptionScores::occluder_recall, &PerceptionScores::centroid_error};
+  std::optional<double> PerceiveSummary::*mean[kScores] = {
+      &PerceiveSummary::object_precision, &PerceiveSummary::object_recall, &PerceiveSummary::occluder_precision,
+      &PerceiveSummary::occluder_recall, &PerceiveSummary::centroid_error};
+  double sum[kScores] = {};
+  long count[kScores] = {};
   while (max_frames < 0 || summary.frames < max_frames) {
     std::optional<RgbdFrame> frame = source.next();
     if (!frame) {
@@ -36,10 +46,25 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     } else {
       ++summary.lost;
     }
+    if (!f.frame.labels.empty()) {
+      PerceptionTruth truth;
+      truth.centroid = f.frame.object_centroid;
+      truth.r_sphere = ps.r_sphere;
+      f.scores = score_perception(f.frame, f.result, truth, ps);
+      ++summary.scored;
+      for (int k = 0; k < kScores; ++k) {
+        if (!((*f.scores).*score[k])) continue;
+        sum[k] += *((*f.scores).*score[k]);
+        ++count[k];
+      }
+    }
     if (observer) {
       observer(f);
     }
     ++summary.frames;
+  }
+  for (int k = 0; k < kScores; ++k) {
+    if (count[k] > 0) summary.*mean[k] = sum[k] / static_cast<double>(count[k]);
   }
   std::sort(front_end_ms.begin(), front_end_ms.end());
   summary.median_front_end_ms = front_end_ms.empty() ? 0.0 : front_end_ms[front_end_ms.size() / 2];

@@ -53,6 +53,13 @@ nlohmann::ordered_json frame_json(const PerceivedFrame& f, const EstimatorParams
   j["estimate"] = f.estimate ? estimate_to_json(*f.estimate) : nlohmann::ordered_json(nullptr);
   j["counts"] = counts_json(r.counts);
   j["timings_ms"] = timings_json(r.timings, f.estimate_ms);
+  if (f.scores) {  // a labelled frame: the scores against its ground truth (null where undefined)
+    const auto value = [](const std::optional<double>& x) { return x ? nlohmann::ordered_json(*x) : nlohmann::ordered_json(nullptr); };
+    const PerceptionScores& s = *f.scores;
+    j["scores"] = {{"object_precision", value(s.object_precision)},   {"object_recall", value(s.object_recall)},
+                   {"occluder_precision", value(s.occluder_precision)}, {"occluder_recall", value(s.occluder_recall)},
+                   {"centroid_error_m", value(s.centroid_error)}};
+  }
   return j;
 }
 

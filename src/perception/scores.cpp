@@ -132,10 +132,11 @@ PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult
   const std::vector<VoxelLabels::Cell>& all = cells.cells();
   PerceptionScores s;
   const auto r2 = static_cast<float>(truth.r_sphere * truth.r_sphere);
-  const Eigen::Vector3f centre = truth.centroid.cast<float>();
+  const Eigen::Vector3f centre = truth.centroid.value_or(Eigen::Vector3d::Zero()).cast<float>();
+  const auto in_sphere = [&](const Eigen::Vector3f& p) { return truth.centroid && (p - centre).squaredNorm() < r2; };
   for (const VoxelLabels::Cell& c : all) {
     s.object_cells += c.label == kPixelObject ? 1u : 0u;
-    s.occluder_cells += is_occluder(c.label) && (c.mean - centre).squaredNorm() < r2 ? 1u : 0u;
+    s.occluder_cells += is_occluder(c.label) && in_sphere(c.mean) ? 1u : 0u;
   }
 
   // Precision: each of the front end's voxels against its cell. Recall: a
@@ -170,8 +171,7 @@ PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult
   std::size_t object_found = 0, occluder_found = 0;
   for (const VoxelLabels::Cell& c : all) {
     object_found += c.label == kPixelObject && near(object_grid, c.mean) ? 1u : 0u;
-    occluder_found +=
-        is_occluder(c.label) && (c.mean - centre).squaredNorm() < r2 && near(occluder_grid, c.mean) ? 1u : 0u;
+    occluder_found += is_occluder(c.label) && in_sphere(c.mean) && near(occluder_grid, c.mean) ? 1u : 0u;
   }
   s.object_precision = ratio(object_right, object_voxels);
   s.object_recall = ratio(object_found, s.object_cells);
@@ -179,7 +179,7 @@ PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult
   s.occluder_recall = ratio(occluder_found, s.occluder_cells);
   if (lost) return s;
 
-  s.centroid_error = (result.centroid - truth.centroid).norm();
+  if (truth.centroid) s.centroid_error = (result.centroid - *truth.centroid).norm();
   if (!truth.surface.empty() && !result.hidden.empty()) {
     std::vector<Eigen::Vector3f> samples;
     samples.reserve(truth.surface.size());

@@ -102,21 +102,27 @@ TumSequenceSource::TumSequenceSource(const std::string& directory,
   }
   const fs::path dir(directory);
   const auto depth = read_list((dir / "depth.txt").string());
-  const auto rgb = fs::exists(dir / "rgb.txt") ? read_list((dir / "rgb.txt").string())
-                                               : std::vector<ListEntry>{};
-  for (const ListEntry& d : depth) {
-    Entry e{d.time, d.file, {}};
-    const auto it = std::lower_bound(rgb.begin(), rgb.end(), d.time,
+  const auto optional_list = [&dir](const char* name) {
+    return fs::exists(dir / name) ? read_list((dir / name).string()) : std::vector<ListEntry>{};
+  };
+  const auto rgb = optional_list("rgb.txt");
+  const auto labels = optional_list("labels.txt");  // ofv's recordings: ground-truth labels
+  // The file of `list` nearest `time`, within max_time_difference; "" when none.
+  const auto nearest = [&options](const std::vector<ListEntry>& list, double time) {
+    const auto it = std::lower_bound(list.begin(), list.end(), time,
                                      [](const ListEntry& x, double t) { return x.time < t; });
     double best = options.max_time_difference;
-    for (auto c = it == rgb.begin() ? it : it - 1; c != rgb.end() && c <= it; ++c) {
-      if (std::abs(c->time - d.time) <= best) {
-        best = std::abs(c->time - d.time);
-        e.rgb = c->file;
+    std::string file;
+    for (auto c = it == list.begin() ? it : it - 1; c != list.end() && c <= it; ++c) {
+      if (std::abs(c->time - time) <= best) {
+        best = std::abs(c->time - time);
+        file = c->file;
       }
     }
-    entries_.push_back(e);
-  }
+    return file;
+  };
+  for (const ListEntry& d : depth) entries_.push_back(Entry{d.time, d.file, nearest(rgb, d.time), nearest(labels, d.time)});
+  if (fs::exists(dir / "object.txt")) objects_ = read_pose_file((dir / "object.txt").string());
   const std::string ground_truth = (dir / "groundtruth.txt").string();
   if (!fs::exists(ground_truth)) {
     throw std::invalid_argument(ground_truth + ": missing (the camera pose of each depth image)");
@@ -181,6 +187,15 @@ std::optional<RgbdFrame> TumSequenceSource::next() {
     }
     f.rgb = rgb.decode<std::uint8_t>(PNG_FORMAT_RGB);
   }
+  if (!e.labels.empty()) {
+    const std::string labels_path = (dir / e.labels).string();
+    Png labels(labels_path, "label image");
+    if (!labels.is_grey16() || labels.width() != depth.width() || labels.height() != depth.height()) {
+      throw std::invalid_argument(labels_path + ": label image: expected a 16-bit grey PNG the size of the depth image");
+    }
+    f.labels = labels.decode<std::uint16_t>(PNG_FORMAT_LINEAR_Y);
+  }
+  if (!objects_.empty()) f.object_centroid = interpolate_pose(objects_, e.time).translation();
   return f;
 }
 
@@ -253,6 +268,29 @@ void TumSequenceWriter::write(const RgbdFrame& frame) {
   }
   std::ofstream(dir / "groundtruth.txt", std::ios::app)
       << format_pose_line(frame.timestamp, frame.wMc);
+  if (!frame.labels.empty()) {
+    const std::string labels_name = std::string("labels/") + stamp + ".png";
+    if (!labels_started_) {
+      fs::create_directories(dir / "labels");
+      std::ofstream(dir / "labels.txt", std::ios::trunc) << "# ground-truth labels (16-bit PNG, ofv::PixelLabel)\n# timestamp filename\n";
+      labels_started_ = true;
+    }
+    const cv::Mat labels(h, w, CV_16UC1, const_cast<std::uint16_t*>(frame.labels.data()));
+    if (!cv::imwrite((dir / labels_name).string(), labels)) {
+      throw std::runtime_error((dir / labels_name).string() + ": cannot write");
+    }
+    std::ofstream(dir / "labels.txt", std::ios::app) << time << ' ' << labels_name << '\n';
+  }
+  if (frame.object_centroid) {
+    if (!object_started_) {
+      std::ofstream(dir / "object.txt", std::ios::trunc)
+          << "# the object's true surface centroid (ground truth), as a pose without rotation\n"
+             "# timestamp tx ty tz qx qy qz qw\n";
+      object_started_ = true;
+    }
+    std::ofstream(dir / "object.txt", std::ios::app)
+        << format_pose_line(frame.timestamp, Eigen::Isometry3d(Eigen::Translation3d(*frame.object_centroid)));
+  }
   ++count_;
 }
 

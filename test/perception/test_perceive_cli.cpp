@@ -78,6 +78,38 @@ TEST(PerceiveCli, TumSequenceGivesProblemsForOfvEstimateAndPictures) {
   }
 }
 
+// A recording that carries ground truth (ofv's own, here made by hand from
+// the synthetic scene's labels): every frame is scored, in its JSON and in
+// the summary's means.
+TEST(PerceiveCli, ARecordingWithLabelsIsScored) {
+  const fs::path dir = fs::path(test::scratch_dir()) / "ofv_perceive_labelled";
+  const fs::path out = fs::path(test::scratch_dir()) / "ofv_perceive_labelled_out";
+  fs::remove_all(dir);
+  fs::remove_all(out);
+  {
+    TumSequenceWriter writer(dir.string());
+    const test::SyntheticScene scene = test::table_and_case();
+    for (int k = 0; k < 3; ++k) {
+      std::vector<int> labels;
+      RgbdFrame f = scene.render(test::vga(320), test::front_camera(), &labels, k / 30.0);
+      f.labels.resize(labels.size());
+      std::transform(labels.begin(), labels.end(), f.labels.begin(), [](int label) {
+        return label == test::kObject ? kPixelObject : label == test::kTable ? kPixelSupport : kPixelNone;
+      });
+      writer.write(f);
+    }
+  }
+  const CommandRun r = run("perceive " + dir.string() + " --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("scores over 3 labelled frames"), std::string::npos) << r.err;
+  std::ifstream in(out / "frame_000002.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_GE(j["scores"]["object_precision"].get<double>(), 0.98);
+  EXPECT_GE(j["scores"]["object_recall"].get<double>(), 0.95);
+  EXPECT_TRUE(j["scores"]["centroid_error_m"].is_null());  // the recording has no object centroid
+  EXPECT_TRUE(j["scores"]["occluder_recall"].is_null());
+}
+
 TEST(PerceiveCli, OniRecordingStreamsJsonLines) {
   const fs::path oni = fs::path(test::scratch_dir()) / "ofv_perceive.oni";
   {

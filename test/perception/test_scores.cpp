@@ -177,6 +177,17 @@ TEST(PerceptionScores, NoOccluderInTheSphereGivesNoOccluderRecall) {
   EXPECT_FALSE(s.occluder_precision);  // nothing called occluder
 }
 
+TEST(PerceptionScores, WithoutTheTrueCentroidThereIsNoOccluderRecallNorCentroidError) {
+  const RgbdFrame f = labelled_wall();
+  const PerceptionResult r = result_of(f, perfect);
+  const PerceptionScores s = score_perception(f, r, PerceptionTruth{}, every_pixel());
+  EXPECT_DOUBLE_EQ(*s.object_precision, 1.0);
+  EXPECT_DOUBLE_EQ(*s.object_recall, 1.0);
+  EXPECT_DOUBLE_EQ(*s.occluder_precision, 1.0);
+  EXPECT_FALSE(s.occluder_recall);
+  EXPECT_FALSE(s.centroid_error);
+}
+
 TEST(PerceptionScores, HiddenErrorIsTheDistanceToTheTrueSurface) {
   const RgbdFrame f = labelled_wall();
   PerceptionResult r = result_of(f, perfect);

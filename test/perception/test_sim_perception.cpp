@@ -247,7 +247,9 @@ TEST(SimPerception, LabelsModeIsAPerfectClassifierOfTheFrame) {
     const PerceptionResult r = perception.process(rendered.frame);
     ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k;
     PerceptionTruth truth;
-    truth.centroid = renderer.truth(scenario.wMc_start, settings.r_sphere).centroid;
+    truth.centroid = rendered.frame.object_centroid;
+    ASSERT_TRUE(truth.centroid);
+    EXPECT_LT((*truth.centroid - renderer.truth(scenario.wMc_start, settings.r_sphere).centroid).norm(), 1e-12);
     truth.r_sphere = settings.r_sphere;
     truth.surface = renderer.object_surface();
     const PerceptionScores s = score_perception(rendered.frame, r, truth, settings);

@@ -74,6 +74,46 @@ TEST(TumSequence, WritesAndReadsBackFrames) {
   EXPECT_FALSE(source.next());
 }
 
+// ofv's own recordings keep a frame's ground truth: its labels and the
+// object's centroid; frames without them read back without them.
+TEST(TumSequence, WritesAndReadsBackTheGroundTruth) {
+  const fs::path dir = scratch("tum_truth");
+  auto frames = episode(3);
+  for (std::size_t k = 0; k < 2; ++k) {
+    RgbdFrame& f = frames[k];
+    f.labels.resize(f.depth.size());
+    for (std::size_t i = 0; i < f.labels.size(); ++i) f.labels[i] = static_cast<std::uint16_t>((i * 7 + k) % 13);
+    f.object_centroid = Eigen::Vector3d(0.1 * static_cast<double>(k), -0.2, 0.5);
+  }
+  {
+    TumSequenceWriter writer(dir.string());
+    for (const RgbdFrame& f : frames) writer.write(f);
+  }
+  EXPECT_TRUE(fs::exists(dir / "labels.txt"));
+  EXPECT_TRUE(fs::exists(dir / "object.txt"));
+  TumSequenceSource source(dir.string());
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto read = source.next();
+    ASSERT_TRUE(read);
+    EXPECT_EQ(read->labels, frames[k].labels);
+    ASSERT_TRUE(read->object_centroid);
+    EXPECT_LT((*read->object_centroid - *frames[k].object_centroid).norm(), 1e-9);
+  }
+  const auto last = source.next();  // written without labels: none read; the centroid held from the last
+  ASSERT_TRUE(last);
+  EXPECT_TRUE(last->labels.empty());
+  // A label image of the wrong kind is refused, naming it.
+  const fs::path first_labels = dir / "labels" / "0.000000.png";
+  fs::copy_file(dir / "rgb" / "0.000000.png", first_labels, fs::copy_options::overwrite_existing);
+  TumSequenceSource broken(dir.string());
+  try {
+    (void)broken.next();
+    ADD_FAILURE() << "a colour PNG was read as labels";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("label image"), std::string::npos) << e.what();
+  }
+}
+
 TEST(TumSequence, AssociatesNearestColourAndInterpolatesPoses) {
   const fs::path dir = scratch("tum_assoc");
   const auto frames = episode(2);

@@ -19,6 +19,7 @@
 #include "ofv/estimator.h"
 #include "ofv/frame_source.h"
 #include "ofv/perception/perception.h"
+#include "ofv/perception/scores.h"
 #include "ofv/rgbd_frame.h"
 
 #include <functional>
@@ -37,6 +38,10 @@ struct PerceivedFrame {
   /// The view estimated from `result.problem`; std::nullopt when the object is lost.
   std::optional<ViewEstimate> estimate;
   double estimate_ms = 0.0;  ///< wall time of estimate_view() [ms]; 0 when lost
+  /// The front end scored against the frame's ground truth (scores.h), for
+  /// a frame that carries labels (ofv's own recordings); its object
+  /// centroid, when the frame has one, centres the occluders' sphere.
+  std::optional<PerceptionScores> scores;
 };
 
 /// \brief What perceive() did over the whole sequence.
@@ -46,6 +51,10 @@ struct PerceiveSummary {
   /// Median of the front end's total time per frame (PerceptionTimings::total)
   /// [ms]: the upper median, element frames / 2 of the sorted times; 0 without frames.
   double median_front_end_ms = 0.0;
+  long scored = 0;  ///< frames with labels, scored
+  /// Means over the scored frames of each score that is defined there
+  /// (PerceptionScores; hidden_error needs the object's surface, which a recording lacks).
+  std::optional<double> object_precision, object_recall, occluder_precision, occluder_recall, centroid_error;
 };
 
 /**

@@ -37,7 +37,7 @@
  *   surface.
  *
  * A measure whose denominator is empty is std::nullopt (no occluder in the
- * sphere: no occluder recall).
+ * sphere: no occluder recall), and so is one whose truth is not known.
  */
 #pragma once
 
@@ -89,8 +89,10 @@ class VoxelLabels {
 
 /// \brief What the scores compare against, besides the frame's labels.
 struct PerceptionTruth {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< the object's true surface centroid [m]
-  double r_sphere = 0.3;                               ///< occluders are scored within this of it [m]
+  /// The object's true surface centroid [m]; without it no occluder recall
+  /// (whose sphere it centres) and no centroid error.
+  std::optional<Eigen::Vector3d> centroid;
+  double r_sphere = 0.3;  ///< occluders are scored within this of the centroid [m]
   /// Samples of the object's true surface at the frame's time [m]; empty:
   /// no hidden error.
   std::vector<Eigen::Vector3d> surface;

@@ -9,6 +9,10 @@
  * `t tx ty tz qx qy qz qw`, camera -> world, optical axes X right, Y down,
  * Z forward) and, optionally, `intrinsics.txt` (`width height fx fy cx cy`,
  * an ofv addition; without it the TUM default 525, 525, 319.5, 239.5 is used).
+ * ofv's own recordings of simulated episodes add their ground truth, read
+ * into RgbdFrame::labels and RgbdFrame::object_centroid when present:
+ * `labels/` (16-bit PNGs of ofv::PixelLabel) listed in `labels.txt`, and
+ * `object.txt` (the object's surface centroid, as pose lines without rotation).
  * Images are PNG files of at most kMaxImageSide pixels a side; a depth image
  * is 16-bit grey.
  */
@@ -58,13 +62,15 @@ class TumSequenceSource : public FrameSource {
   struct Entry {
     double time;
     std::string depth;
-    std::string rgb;  // empty: no colour within max_time_difference
+    std::string rgb;     // empty: no colour within max_time_difference
+    std::string labels;  // empty: no labels within max_time_difference
   };
   std::string directory_;
   TumSequenceOptions options_;
   CameraIntrinsics intrinsics_;
   std::vector<Entry> entries_;
   std::vector<StampedPose> poses_;
+  std::vector<StampedPose> objects_;  // object.txt: the object's centroid over time
   std::size_t next_ = 0;
 };
 
@@ -72,7 +78,8 @@ class TumSequenceSource : public FrameSource {
  * \brief Writes frames as a TUM RGB-D sequence (plus intrinsics.txt).
  *
  * Depth is stored as round(depth * 5000) in 16 bits (up to 13.1 m; missing,
- * non-finite or larger depths become 0).
+ * non-finite or larger depths become 0). A frame's ground truth (labels,
+ * object centroid) is written when it has one.
  */
 class TumSequenceWriter {
  public:
@@ -91,6 +98,8 @@ class TumSequenceWriter {
   double last_time_ = 0.0;
   std::size_t count_ = 0;
   bool intrinsics_written_ = false;
+  bool labels_started_ = false;  // labels/ and labels.txt begun (frames with labels)
+  bool object_started_ = false;  // object.txt begun (frames with object_centroid)
 };
 
 }  // namespace ofv

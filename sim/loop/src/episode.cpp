@@ -103,10 +103,10 @@ PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
 }
 
 // The front end's output against the frame's labels and the object's true surface.
-PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, const StepRecord& rec,
-                       const sim::Renderer& renderer, const PerceptionSettings& settings) {
+PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, const sim::Renderer& renderer,
+                       const PerceptionSettings& settings) {
   PerceptionTruth truth;
-  truth.centroid = rec.true_centroid;
+  truth.centroid = frame.object_centroid;
   truth.r_sphere = settings.r_sphere;
   truth.surface = renderer.object_surface();
   return score_perception(frame, result, truth, settings);
@@ -236,7 +236,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
       problem = std::move(gt_problem);
     }
     rec.times.perception = seconds_since(start);
-    if (result) rec.perception = score(rendered.frame, *result, rec, renderer, perception->settings());
+    if (result) rec.perception = score(rendered.frame, *result, renderer, perception->settings());
 
     // The frame is as old as 1 + latency periods when its command is replaced.
     const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency), shown, beyond_view);
@@ -293,7 +293,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     rec.wMc = f.frame->wMc;
     (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
     rec.occluders_in_view = sim::occluders_seen(f.frame->labels);
-    if (f.perception) rec.perception = score(*f.frame, *f.perception, rec, renderer, front_end_settings(setup));
+    if (f.perception) rec.perception = score(*f.frame, *f.perception, renderer, front_end_settings(setup));
     rec.times.render = f.source_s;
     rec.times.perception = f.perception_s;
     record_step(rec, *f.step);

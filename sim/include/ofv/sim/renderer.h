@@ -29,7 +29,7 @@ enum Label : std::uint16_t {
   kLabelOccluder0 = kPixelOccluder0,      ///< occluder k is kLabelOccluder0 + k
 };
 
-/// \brief A rendered frame; its ground-truth labels are `frame.labels`.
+/// \brief A rendered frame; its ground truth is `frame.labels` and `frame.object_centroid`.
 struct RenderedFrame {
   RgbdFrame frame;
 };
