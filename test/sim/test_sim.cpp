@@ -393,5 +393,42 @@ TEST(Renderer, AFrameRenderedIntoAnotherIsTheFrameRenderedAfresh) {
   }
 }
 
+// A dark or shiny body (`dropout`) loses that fraction of its depth pixels
+// with the sensor's noise on, and none with it off; the others keep theirs.
+// The labels and the object's centroid are the frame's ground truth either way.
+TEST(Render, ADarkBodyLosesItsDropoutOfDepthPixels) {
+  const std::string scene =
+      "object: {shape: box, size: [0.2, 0.2, 0.01], position: [0, 0, 0.5], dropout: 0.4}\n"
+      "occluders: [{shape: box, size: [0.1, 0.1, 0.01], position: [0.15, 0, 0.45]}]\n";
+  const auto with_noise = [&](bool noise) {
+    return scenario_from_yaml("sensor: {noise: {enabled: " + std::string(noise ? "true" : "false") +
+                                  ", grazing_deg: 89, edge_dropout: 0}}\n" + scene,
+                              "dark.yaml");
+  };
+  const auto missing = [](const RenderedFrame& r, std::uint16_t label) {
+    int shown = 0, lost = 0;
+    for (std::size_t i = 0; i < r.frame.labels.size(); ++i) {
+      if (r.frame.labels[i] != label) continue;
+      ++shown;
+      lost += r.frame.depth[i] > 0.0f ? 0 : 1;
+    }
+    return static_cast<double>(lost) / shown;
+  };
+  const Scenario noisy = with_noise(true);
+  Renderer dark(noisy);
+  dark.set_time(0.0);
+  const RenderedFrame a = dark.render(noisy.wMc_start, 0);
+  EXPECT_NEAR(missing(a, kLabelObject), 0.4, 0.03);
+  EXPECT_EQ(missing(a, kLabelOccluder0), 0.0);
+  ASSERT_TRUE(a.frame.object_centroid);
+  EXPECT_LT((*a.frame.object_centroid - Eigen::Vector3d(0, 0, 0.5)).norm(), 3e-3);  // of 4000 random surface samples
+  const Scenario clean = with_noise(false);
+  Renderer bright(clean);
+  bright.set_time(0.0);
+  EXPECT_EQ(missing(bright.render(clean.wMc_start, 0), kLabelObject), 0.0);
+  EXPECT_THROW((void)scenario_from_yaml("object: {shape: box, dropout: 1.5}", "bad.yaml"), std::invalid_argument);
+}
+
+
 }  // namespace
 }  // namespace ofv::sim
