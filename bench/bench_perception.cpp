@@ -1,7 +1,9 @@
 // Perception front end speed: BM_Perception/<width> on a tracking frame
 // (table, DVD case held by a hand, an arm in front), 640x480 and 320x240.
 // Counters give each stage's mean wall time [ms] and the sizes it worked on.
+// BM_PerceptionScores/<width>: scoring that frame's result against its labels.
 #include "ofv/perception/perception.h"
+#include "ofv/perception/scores.h"
 
 #include "synthetic_scene.h"  // test/perception: analytic ray casting
 
@@ -9,7 +11,7 @@
 
 namespace {
 
-ofv::RgbdFrame scene_frame(int width) {
+ofv::RgbdFrame scene_frame(int width, std::vector<int>* labels = nullptr) {
   using namespace ofv::test;
   SyntheticScene scene = table_and_case();
   const Eigen::Vector3d skin(225, 170, 140);
@@ -17,7 +19,7 @@ ofv::RgbdFrame scene_frame(int width) {
       make_capsule({0.115, -0.005, 0.03}, {0.115, -0.005, 0.12}, 0.02, skin, kHand));
   scene.shapes.push_back(
       make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025, skin, kHand));
-  return scene.render(vga(width), front_camera());
+  return scene.render(vga(width), front_camera(), labels);
 }
 
 void BM_Perception(benchmark::State& state) {
@@ -53,5 +55,23 @@ void BM_Perception(benchmark::State& state) {
   state.counters["occluders"] = static_cast<double>(counts.occluders);
 }
 BENCHMARK(BM_Perception)->Arg(640)->Arg(320)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PerceptionScores(benchmark::State& state) {
+  std::vector<int> labels;
+  ofv::RgbdFrame frame = scene_frame(static_cast<int>(state.range(0)), &labels);
+  frame.labels.assign(labels.begin(), labels.end());  // the synthetic scene's own label values
+  const ofv::PerceptionSettings settings;
+  ofv::Perception perception{settings};
+  (void)perception.process(frame);
+  const ofv::PerceptionResult r = perception.process(frame);
+  ofv::PerceptionTruth truth;
+  truth.centroid = r.centroid;
+  truth.r_sphere = settings.r_sphere;
+  for (auto _ : state) {
+    const ofv::PerceptionScores s = ofv::score_perception(frame, r, truth, settings);
+    benchmark::DoNotOptimize(s.object_cells);
+  }
+}
+BENCHMARK(BM_PerceptionScores)->Arg(640)->Arg(320)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

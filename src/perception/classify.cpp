@@ -132,16 +132,18 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
   r.axes = axes;
   r.obb = augmented_obb(object_cloud, c, axes, settings.obb_margin);
 
-  // Interacting: inside the augmented OBB and within obb_margin of the
-  // object's voxels. For a compact object that is the whole box; the empty
-  // part of the box of a bent or folded object (a hand in a cloth's
-  // hollow) holds no interacting element but occluders.
+  // Interacting: inside the augmented OBB and in contact with the object
+  // (a voxel within contact_distance of one of its voxels). The empty part
+  // of the box of a bent or folded object (a hand in a cloth's hollow, over
+  // its fold) holds occluders, not interacting elements.
   object_points.clear();
   for (const Eigen::Vector3d& p : object_cloud) object_points.push_back(p.cast<float>());
-  object_grid.build(object_points, settings.obb_margin);
-  const auto near_object = [this](const Eigen::Vector3d& p) {
-    return object_grid.any_within(p.cast<float>(), static_cast<float>(settings.obb_margin), [](int) { return true; });
-  };
+  object_grid.build(object_points, settings.contact_distance);
+  std::vector<char> touches(n, 0);
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    char& t = touches[static_cast<std::size_t>(r.voxel_owner[i])];
+    t = t || object_grid.any_within(r.voxels[i], static_cast<float>(settings.contact_distance), [](int) { return true; });
+  }
 
   // Labels (paper II-B) and the estimator's input. Classes::Labels: the
   // frame's labels of each supervoxel (supervoxel_labels) for the bodies.
@@ -171,7 +173,7 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
       }
     } else if (!settings.support_plane_occludes && (labelled ? truth[i] == kPixelSupport : on_plane(s))) {
       s.label = SupervoxelClass::Background;
-    } else if (r.obb.contains(s.centroid) && near_object(s.centroid)) {
+    } else if (r.obb.contains(s.centroid) && touches[i]) {
       s.label = SupervoxelClass::Interacting;
       ++r.counts.interacting;
     } else if ((s.centroid - c).norm() < settings.r_sphere) {

@@ -95,6 +95,7 @@ void validate(const PerceptionSettings& s) {
   require(positive(s.max_depth), "max_depth", s.max_depth, "> 0 [m]");
   require(std::isfinite(s.obb_margin) && s.obb_margin >= 0.0, "obb_margin", s.obb_margin,
           ">= 0 [m]");
+  require(positive(s.contact_distance), "contact_distance", s.contact_distance, "> 0 [m]");
   if (s.selection.mode == ObjectSelection::Mode::Box && s.selection.box.isEmpty()) {
     throw std::invalid_argument("perception selection: mode box needs a non-empty box");
   }

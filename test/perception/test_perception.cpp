@@ -566,6 +566,7 @@ TEST(Perception, RejectsInvalidSettings) {
   throws([](PerceptionSettings& s) { s.supervoxels.voxel_resolution = 0.0; });
   throws([](PerceptionSettings& s) { s.supervoxels.seed_resolution = 0.001; });
   throws([](PerceptionSettings& s) { s.r_sphere = -1.0; });
+  throws([](PerceptionSettings& s) { s.contact_distance = 0.0; });
   throws([](PerceptionSettings& s) { s.tracking.min_near_fraction = 0.0; });
   throws([](PerceptionSettings& s) { s.selection.mode = ObjectSelection::Mode::Box; });
   throws([](PerceptionSettings& s) { s.selection.mode = ObjectSelection::Mode::Image; });

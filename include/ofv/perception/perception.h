@@ -127,10 +127,15 @@ struct PerceptionSettings {
   double crop_margin = 0.1;  ///< crop radius = r_sphere + crop_margin around the previous C [m]
   double max_depth = 3.0;    ///< points farther along the optical axis are dropped [m]
   /// The object's OBB (PCA of its voxels) grows by this on every side [m]:
-  /// what lies inside it, within this distance of the object's voxels, but
-  /// is not object is interacting (a holding hand). What the box holds
-  /// farther from the object (in the hollow of a bent cloth) is an occluder.
+  /// what lies inside it, in contact with the object (contact_distance), but
+  /// is not object is interacting (a holding hand).
   double obb_margin = 0.03;
+  /// A supervoxel inside the augmented OBB is interacting when one of its
+  /// voxels lies within this distance of an object voxel (seen or
+  /// remembered) [m]: in contact, within two voxels. What the box holds farther
+  /// from the object (in the hollow of a bent cloth, over its fold) is an
+  /// occluder (README, "What perception costs").
+  double contact_distance = 0.015;
   /// The paper's classification makes every non-object supervoxel inside
   /// the sphere an occluder (or, inside the OBB, interacting), the table the
   /// object stands on included. false: supervoxels of the support plane
