@@ -208,10 +208,7 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
   f.depth.assign(pixels, 0.0f);
   f.rgb.assign(3 * pixels, 0);
   f.labels.assign(pixels, kLabelNone);
-  const std::vector<Eigen::Vector3d> surface = object_surface();
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : surface) centroid += p;
-  f.object_centroid = centroid / static_cast<double>(std::max<std::size_t>(surface.size(), 1));
+  f.object_centroid = object_centroid();
   // Scratch kept by each thread that calls render, so a loop of frames
   // reuses it. (The workers below use the caller's, through these references.)
   thread_local std::vector<std::uint8_t> grazing_scratch;
@@ -360,9 +357,9 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
   const Eigen::Isometry3d cMw = wMc.inverse();
   const CameraIntrinsics& k = scenario_.sensor.intrinsics;
   int facing = 0, seen = 0;
+  t.centroid = object_centroid();
   for (const auto& s : samples) {
     const WorldPoint w = at(m, s);
-    t.centroid += w.p;
     if (w.n.dot(o - w.p) <= 0.0) continue;
     ++facing;
     const Eigen::Vector3d pc = cMw * w.p;
@@ -371,7 +368,6 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
     if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
     if (!impl_->occluded(o, w.p)) ++seen;
   }
-  t.centroid /= static_cast<double>(samples.size());
   t.visible_fraction = facing > 0 ? static_cast<double>(seen) / facing : 0.0;
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     if (scenario_.bodies[b].role != Role::Occluder) continue;
@@ -382,6 +378,14 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
     t.occluders_in_sphere += inside ? 1 : 0;
   }
   return t;
+}
+
+Eigen::Vector3d Renderer::object_centroid() const {
+  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
+  const auto& samples = impl_->samples[static_cast<std::size_t>(impl_->object)];
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& s : samples) sum += at(m, s).p;
+  return sum / static_cast<double>(samples.size());
 }
 
 std::vector<Eigen::Vector3d> Renderer::object_surface() const {

@@ -10,6 +10,14 @@
 
 namespace ofv::detail {
 
+/// A grid cell's key: 21 bits per axis (+-8 km at 8 mm cells).
+inline std::uint64_t cell_key(const Eigen::Vector3i& c) {
+  const auto k = [](int x) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(x) + (std::int64_t{1} << 20)) & 0x1FFFFFu;
+  };
+  return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
+}
+
 /// Points hashed on a uniform grid: "is any point within r of p" in O(1).
 class PointGrid {
  public:
@@ -66,13 +74,7 @@ class PointGrid {
   [[nodiscard]] Eigen::Vector3i cell_of(const Eigen::Vector3f& p) const {
     return (p * inv_cell_).array().floor().cast<int>();
   }
-  static std::uint64_t key(const Eigen::Vector3i& c) {
-    const auto k = [](int x) {
-      return static_cast<std::uint64_t>(static_cast<std::int64_t>(x) + (std::int64_t{1} << 20)) &
-             0x1FFFFFu;
-    };
-    return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
-  }
+  static std::uint64_t key(const Eigen::Vector3i& c) { return cell_key(c); }
   float inv_cell_ = 1.0f;
   std::vector<Entry> entries_;
   const std::vector<Eigen::Vector3f>* points_ = nullptr;

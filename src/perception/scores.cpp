@@ -64,7 +64,7 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
       if (!(z > 0.0f) || !std::isfinite(z) || z > static_cast<float>(max_depth)) continue;
       const Eigen::Vector3f pc(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
       const Eigen::Vector3f pw = wRc * pc + wtc;
-      const auto [it, inserted] = index_.try_emplace(key(cell_of(pw, inv_voxel_)), static_cast<int>(cells_.size()));
+      const auto [it, inserted] = index_.try_emplace(detail::cell_key(cell_of(pw, inv_voxel_)), static_cast<int>(cells_.size()));
       if (inserted) {
         cells_.emplace_back();
         votes.emplace_back();
@@ -93,22 +93,15 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
   }
 }
 
-std::uint64_t VoxelLabels::key(const Eigen::Vector3i& c) const {
-  const auto k = [](int x) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(x) + (std::int64_t{1} << 20)) & 0x1FFFFFu;
-  };
-  return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
-}
-
 int VoxelLabels::find(const Eigen::Vector3f& p) const {
   const Eigen::Vector3i c = cell_of(p, inv_voxel_);
-  if (const auto it = index_.find(key(c)); it != index_.end()) return it->second;
+  if (const auto it = index_.find(detail::cell_key(c)); it != index_.end()) return it->second;
   int best = -1;
   float best_d2 = std::numeric_limits<float>::infinity();
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        const auto it = index_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+        const auto it = index_.find(detail::cell_key(c + Eigen::Vector3i(dx, dy, dz)));
         if (it == index_.end()) continue;
         const float d2 = (cells_[static_cast<std::size_t>(it->second)].mean - p).squaredNorm();
         if (d2 < best_d2) {

@@ -81,7 +81,6 @@ class VoxelLabels {
   [[nodiscard]] const std::vector<Cell>& cells() const { return cells_; }
 
  private:
-  [[nodiscard]] std::uint64_t key(const Eigen::Vector3i& cell) const;
   float inv_voxel_ = 1.0f;
   std::unordered_map<std::uint64_t, int> index_;
   std::vector<Cell> cells_;

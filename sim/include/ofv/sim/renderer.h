@@ -79,6 +79,8 @@ class Renderer {
   /// \brief Object ground truth seen from a camera at `wMc` (r_sphere for the occluder count).
   [[nodiscard]] ObjectTruth truth(const Eigen::Isometry3d& wMc, double r_sphere) const;
 
+  /// \brief The object's area-weighted surface centroid (truth()'s) at the current time [m].
+  [[nodiscard]] Eigen::Vector3d object_centroid() const;
   /// \brief The object's surface samples (those of truth()) at the current time [m].
   [[nodiscard]] std::vector<Eigen::Vector3d> object_surface() const;
 
