@@ -2,8 +2,8 @@
 //! Tutorial 4: attach a real robot. Any ViSP vpRobot driver carries the camera;
 //! ofv::VispRobot commands it in the camera frame. ofv::ViewLoop is the
 //! per-frame policy that `ofv simulate` and `ofv run` use: from the frame's
-//! problem (object supervoxels and occluders, from ofv::Perception on your
-//! sensor's frames) and the camera pose to a safe camera twist — view
+//! observation (object supervoxels and occluders, from ofv::PerceptionObserver
+//! on your sensor's frames, and the camera pose) to a safe camera twist — view
 //! selection, target continuity, the controller and the safety filter
 //! (speed, acceleration, workspace, zero velocity when the object is lost or
 //! the frame is stale). This program is compiled everywhere; the driver part
@@ -17,16 +17,17 @@
 //! view and the curves. A left click pauses (the robot is sent a zero
 //! velocity first), a right click or q stops as Ctrl-C does.
 //!
-//! With a sensor, `ofv::run_on_robot(source, robot, settings, options)` runs
-//! this same loop (perception included) until Ctrl-C; `ofv run` is that call.
-//! `options.selection` points out the object in the first frame (a world box
-//! or an image rectangle, as `ofv run --box` / `--rect`); by default the
-//! front end takes the cluster nearest the image centre.
+//! With a sensor, `ofv::run_on_robot(source, perception, robot, settings,
+//! options)` runs this same loop until Ctrl-C, `perception` an
+//! ofv::PerceptionObserver; `ofv run` is that call. The front end's
+//! `PerceptionSettings::selection` points out the object in the first frame
+//! (a world box or an image rectangle, as `ofv run --box` / `--rect`); by
+//! default it takes the cluster nearest the image centre.
 #include <ofv/servo/robot.h>
 #include <ofv/servo/view_loop.h>
+#include <ofv/servo/target_pose.h>
 #if defined(OFV_HAVE_DISPLAY)
 #include <ofv/display/live_display.h>
-#include <ofv/servo/target_pose.h>
 #endif
 
 #include <visp3/core/vpConfig.h>
@@ -112,9 +113,12 @@ int main(int argc, char** argv) {
 #endif
   int clear = 0;
   for (int k = 0; k < 60 && !stop_requested; ++k) {
-    const ofv::ViewProblem problem = frame_problem(k * dt);
+    ofv::Observation seen;  // what ofv::PerceptionObserver::observe gives for a frame
+    seen.problem = frame_problem(k * dt);
     const vpHomogeneousMatrix wMc = robot.wMc();
-    const ofv::LoopStep s = loop.step(problem, wMc, dt, /*frame_age=*/0.0);
+    seen.wMc = ofv::to_eigen(wMc);
+    seen.age = 0.0;  // how old the frame is when the command is sent
+    const ofv::LoopStep s = loop.step(seen, dt);
     if (dry_run) {
       std::cout << "step " << k << ": " << ofv::to_string(s.status) << ", v = " << s.velocity.t();
       if (s.safety != ofv::SafetyAction::None) std::cout << "  (" << ofv::to_string(s.safety) << ')';
@@ -127,7 +131,7 @@ int main(int argc, char** argv) {
       ofv::DisplayInput in;
       in.time = k * dt;
       in.wMc = ofv::to_eigen(wMc);
-      in.problem = &problem;
+      in.observation = &seen;
       in.step = &s;
       if (!live->show(in)) stop_requested = 1;  // the same stop as Ctrl-C
     }

@@ -290,8 +290,10 @@ Command add_run_command(CLI::App& app) {
               options.move_robot = !opt->dry_run || !real;  // simulated robots follow a dry run
               options.max_duration = setup.duration;
               options.stop = &g_stop;
-              options.selection = selection;
-              const RobotLoopSummary summary = run_on_robot(*source, *robot, setup.loop, options, print);
+              PerceptionSettings front_end = front_end_settings(setup);
+              front_end.selection = selection;
+              PerceptionObserver perception(front_end);
+              const RobotLoopSummary summary = run_on_robot(*source, perception, *robot, setup.loop, options, print);
               lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
                         << (summary.stopped ? (user_quit ? ", stopped from the display" : ", stopped by a signal") : "") << '\n';

@@ -183,15 +183,17 @@ struct LiveDisplay::Impl {
       return a.get_u() >= margin && a.get_v() >= margin && a.get_u() < k.width - 1 - margin &&
              a.get_v() < k.height - 1 - margin;
     };
-    if (in.problem) {
-      for (Eigen::Index i = 0; i < in.problem->occluders.cols(); ++i) {
-        const auto a = project(cMw, k, in.problem->occluders.col(i));
+    if (in.observation && in.observation->problem) {
+      const ViewProblem& problem = *in.observation->problem;
+      const Eigen::Matrix3Xd occluders = in.observation->all_occluders();
+      for (Eigen::Index i = 0; i < occluders.cols(); ++i) {
+        const auto a = project(cMw, k, occluders.col(i));
         if (a && inside(*a, 2))
           vpImageDraw::drawRectangle(camera, vpRect(a->get_u() - 1, a->get_v() - 1, 3, 3),
                                      kOccluder, true);
       }
-      for (Eigen::Index i = 0; i < in.problem->positions.cols(); ++i) {
-        const auto a = project(cMw, k, in.problem->positions.col(i));
+      for (Eigen::Index i = 0; i < problem.positions.cols(); ++i) {
+        const auto a = project(cMw, k, problem.positions.col(i));
         if (a && inside(*a, 4)) vpImageDraw::drawCircle(camera, *a, 2, kSupervoxel, 2);
       }
     }
@@ -281,7 +283,7 @@ struct LiveDisplay::Impl {
     } else if (in.step) {
       state.status = in.step->status;
     }
-    state.problem = in.problem;
+    state.observation = in.observation;
     state.step = in.step;
     state.target = target;
     const RgbPicture picture = scene_picture(state, path, options.r_sphere);
@@ -440,7 +442,7 @@ bool LiveDisplay::observe(const StepRecord& record, const StepDetail& detail) {
   in.time = record.time;
   in.wMc = record.wMc;
   in.frame = detail.frame;
-  in.problem = detail.problem;
+  in.observation = detail.observation;
   in.step = detail.step;
   in.centroid = record.true_centroid;
   in.visible_fraction = record.visible_fraction;
@@ -455,9 +457,9 @@ bool LiveDisplay::observe(const RobotLoopFrame& f) {
     in.wMc = f.frame->wMc;
     in.frame = f.frame;
   }
-  if (f.perception && f.perception->status != TrackingStatus::Lost) {
-    in.problem = &f.perception->problem;
-    in.centroid = f.perception->centroid;
+  in.observation = f.observation;
+  if (f.observation && f.observation->problem && f.observation->problem->positions.cols() > 0) {
+    in.centroid = f.observation->problem->positions.rowwise().mean();
   }
   in.step = f.step;
   return show(in);

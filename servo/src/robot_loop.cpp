@@ -1,4 +1,4 @@
-// The closed loop on a robot: source → perception → ViewLoop → robot.
+// The closed loop on a robot: source → observer (perception) → ViewLoop → robot.
 #include "ofv/servo/robot_loop.h"
 
 #include "ofv/servo/target_pose.h"
@@ -8,20 +8,11 @@
 
 namespace ofv {
 
-RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const LoopSettings& settings,
-                              const RobotLoopOptions& options,
-                              const std::function<void(const RobotLoopFrame&)>& observer) {
+RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
+                              const LoopSettings& settings, const RobotLoopOptions& options,
+                              const std::function<void(const RobotLoopFrame&)>& on_frame) {
   using Clock = std::chrono::steady_clock;
   ViewLoop loop(settings);
-  std::optional<Perception> perception;
-  if (!options.problem_source) {
-    PerceptionSettings front_end = perception_settings(loop.estimator());
-    front_end.selection = options.selection;
-    front_end.classes = options.classes;
-    front_end.beyond_view = settings.beyond_view;
-    front_end.behind_occluders = settings.behind_occluders;
-    perception.emplace(front_end);
-  }
   const auto rest = [&] {
     if (options.move_robot) (void)robot.step(vpColVector(6, 0.0), 0.0);
   };
@@ -50,22 +41,12 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       out.index = summary.frames;
       out.frame = &*frame;
       out.source_s = std::chrono::duration<double>(arrived - asked).count();
-      std::optional<ViewProblem> problem;
-      std::optional<double> shown;
-      Eigen::Index beyond_view = 0;
-      PerceptionResult result;
-      if (options.problem_source) {
-        problem = options.problem_source(*frame);
-      } else {
-        result = perception->process(*frame);
-        if (result.status != TrackingStatus::Lost) problem = result.problem;
-        shown = shown_object(result);
-        beyond_view = static_cast<Eigen::Index>(result.counts.beyond_view);
-        out.perception = &result;
-      }
+      Observation observation = observer.observe(*frame);
+      observation.wMc = frame->wMc;
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
-      out.frame_age = options.wall_clock_age ? out.perception_s : gap;
-      const LoopStep step = loop.step(std::move(problem), to_visp(frame->wMc), dt, out.frame_age, shown, beyond_view);
+      observation.age = out.frame_age = options.wall_clock_age ? out.perception_s : gap;
+      out.observation = &observation;
+      const LoopStep step = loop.step(observation, dt);
       out.step = &step;
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
       // A period that is not finite and positive (a timestamp going backwards
@@ -73,7 +54,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const Loo
       out.dt = std::isfinite(dt) && dt > 0.0 ? dt : 0.0;
       if (options.move_robot) (void)robot.step(step.velocity, out.dt);
       ++summary.frames;
-      if (observer) observer(out);
+      if (on_frame) on_frame(out);
     }
   } catch (...) {
     // Stop, then report the error that ended the run, not the stop's own

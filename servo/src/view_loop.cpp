@@ -2,6 +2,7 @@
 #include "ofv/servo/view_loop.h"
 
 #include "ofv/estimator_settings.h"
+#include "ofv/servo/target_pose.h"
 
 #include <algorithm>
 #include <chrono>
@@ -127,14 +128,6 @@ SettingsTable<LoopSettings> make_table() {
          "time constant of a low-pass on the target position; 0 = off"},
         [](L& l, const std::string& v) { l.controller.target_filter = parse_number("target_filter", v, 0.0, 10.0, false); },
         [](const L& l) { return format_number(l.controller.target_filter); });
-  t.add({"beyond_view", "bool", format_bool(d.beyond_view), "",
-         "the front end (perception full or labels): an occluder the image border cuts goes on beyond it, to the sphere (false: only what the frame shows)"},
-        [](L& l, const std::string& v) { l.beyond_view = parse_bool("beyond_view", v); },
-        [](const L& l) { return format_bool(l.beyond_view); });
-  t.add({"behind_occluders", "bool", format_bool(d.behind_occluders), "",
-         "the front end (perception full or labels): when an occluder cuts the object in the first frame, the object goes on behind it (false: only what has been seen)"},
-        [](L& l, const std::string& v) { l.behind_occluders = parse_bool("behind_occluders", v); },
-        [](const L& l) { return format_bool(l.behind_occluders); });
   t.add({"target_hysteresis", "bool", format_bool(d.target_hysteresis), "",
          "while t0 is occluded, continue from the previous target (warm start) instead of re-estimating from t0"},
         [](L& l, const std::string& v) { l.target_hysteresis = parse_bool("target_hysteresis", v); },
@@ -537,13 +530,18 @@ Eigen::Matrix3Xd ViewLoop::predicted(const Eigen::Vector3d& centroid) const {
   return all(Eigen::all, inside);
 }
 
-LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
-                        double frame_age, std::optional<double> shown, Eigen::Index untracked) {
+LoopStep ViewLoop::step(const Observation& observation, double dt) {
   LoopStep out;
   reserve_estimator_memory(kReservedOcclusionPoints);  // once per thread
   auto start = Clock::now();
+  const vpHomogeneousMatrix wMc = to_visp(observation.wMc);
+  const double frame_age = observation.age;
+  // The estimator avoids the occluders seen and those presumed (last).
+  std::optional<ViewProblem> problem = observation.problem;
+  const Eigen::Index seen = problem ? problem->occluders.cols() : 0;
   if (problem) {
-    problem->camera = Eigen::Vector3d(wMc[0][3], wMc[1][3], wMc[2][3]);
+    if (observation.presumed.cols() > 0) problem->occluders = observation.all_occluders();
+    problem->camera = observation.wMc.translation();
     problem->previous_view = previous_view_;
     out.estimate = estimate_view(*problem, estimator_);
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
@@ -553,9 +551,6 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
     tracker_.reset();
     track_history_.clear();
   }
-  // The occluders seen in the frame: those presumed (untracked) come last.
-  const Eigen::Index seen =
-      problem ? problem->occluders.cols() - std::clamp<Eigen::Index>(untracked, 0, problem->occluders.cols()) : 0;
   if (problem) {
     out.presumed_occluders = problem->occluders.cols() - seen;
     out.tracks = tracker_.update(problem->occluders.leftCols(seen), dt);
@@ -611,15 +606,15 @@ LoopStep ViewLoop::step(std::optional<ViewProblem> problem, const vpHomogeneousM
       }
     }
     out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate, kept);
-    if (settings_.method == ViewMethod::Estimator && shown) {
-      out.target = retreat(*problem, seen, *out.estimate, *shown, dt, out.target);
+    if (settings_.method == ViewMethod::Estimator && observation.shown_area) {
+      out.target = retreat(*problem, seen, *out.estimate, *observation.shown_area, dt, out.target);
       out.target = look_ahead(*problem, out.estimate->centroid, out.target, dt, frame_age);
     }
     previous_view_ = out.estimate->tf;
     previous_target_ = out.target;
     last_centroid_ = out.estimate->centroid;
   } else if (settings_.method == ViewMethod::Estimator) {
-    out.target = way_back(Eigen::Vector3d(wMc[0][3], wMc[1][3], wMc[2][3]), dt);
+    out.target = way_back(observation.wMc.translation(), dt);
   }
   out.estimate_s = seconds_since(start);
 

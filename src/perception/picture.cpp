@@ -31,9 +31,9 @@ const cv::Scalar kCyan = rgb(0, 255, 255);
 const cv::Scalar kMagenta = rgb(255, 60, 255);
 
 /// A pinhole observer looking at `target` from `eye`, `up` roughly up in the image.
-class Observer {
+class Viewpoint {
  public:
-  Observer(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up,
+  Viewpoint(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up,
            double focal)
       : focal_(focal) {
     const Eigen::Vector3d z = (target - eye).normalized();
@@ -73,7 +73,7 @@ void point(cv::Mat& image, const cv::Point2d& p, const cv::Scalar& colour, int s
   cv::rectangle(image, cv::Rect(pixel(p), cv::Size(size, size)), colour, cv::FILLED);
 }
 
-void line(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+void line(cv::Mat& image, const Viewpoint& obs, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
           const cv::Scalar& colour, int thickness = 1) {
   const auto pa = obs(a);
   const auto pb = obs(b);
@@ -82,14 +82,14 @@ void line(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& a, const E
   }
 }
 
-void dot(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+void dot(cv::Mat& image, const Viewpoint& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
          int size) {
   if (const auto ip = obs(p); ip && ip->x >= 0 && ip->y >= 0 && ip->x < kWidth && ip->y < kHeight) {
     point(image, *ip, colour, size);
   }
 }
 
-void square(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+void square(cv::Mat& image, const Viewpoint& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
             double half) {
   if (const auto ip = obs(p)) {
     const auto side = static_cast<int>(2 * half);
@@ -109,7 +109,7 @@ void text(cv::Mat& image, const std::string& s, const cv::Point2d& at, const cv:
   }
 }
 
-void marker(cv::Mat& image, const Observer& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
+void marker(cv::Mat& image, const Viewpoint& obs, const Eigen::Vector3d& p, const cv::Scalar& colour,
             const std::string& label) {
   if (const auto ip = obs(p)) {
     cv::circle(image, pixel(*ip), 7, colour, 2);
@@ -137,7 +137,7 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
   back.normalize();
   const Eigen::Vector3d dir =
       (Eigen::AngleAxisd(55.0 * kPi / 180.0, cam_up) * back + 0.5 * cam_up).normalized();
-  const Observer obs(c + 2.4 * r_sphere * dir, c, cam_up, 0.9 * kHeight);
+  const Viewpoint obs(c + 2.4 * r_sphere * dir, c, cam_up, 0.9 * kHeight);
 
   // The sphere as three great circles.
   if (tracked) {

@@ -187,4 +187,12 @@ PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult
   return s;
 }
 
+double labelled_shown_area(const RgbdFrame& frame, const PerceptionSettings& settings) {
+  const double voxel = settings.supervoxels.voxel_resolution;
+  const VoxelLabels cells(frame, voxel, settings.cloud.pixel_stride, settings.max_depth);
+  const auto object = std::count_if(cells.cells().begin(), cells.cells().end(),
+                                    [](const VoxelLabels::Cell& c) { return c.label == kPixelObject; });
+  return static_cast<double>(object) * voxel * voxel;
+}
+
 }  // namespace ofv

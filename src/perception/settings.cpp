@@ -1,15 +1,53 @@
 // The front end's settings checked, and its closed sets of words.
 #include "ofv/perception/perception.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
 namespace ofv {
 
-std::optional<double> shown_object(const PerceptionResult& result) {
-  if (result.status == TrackingStatus::Lost) return std::nullopt;
-  return static_cast<double>(result.counts.object_voxels);
+Observation observation(const PerceptionResult& result, double voxel) {
+  Observation o;
+  o.wMc = result.wMc;
+  if (result.status == TrackingStatus::Lost) return o;
+  // The occluders beyond the image border come last (classify, then beyond_view).
+  const Eigen::Index all = result.problem.occluders.cols();
+  const Eigen::Index presumed = std::min<Eigen::Index>(static_cast<Eigen::Index>(result.counts.beyond_view), all);
+  o.problem = result.problem;
+  o.problem->occluders = result.problem.occluders.leftCols(all - presumed);
+  o.presumed = result.problem.occluders.rightCols(presumed);
+  o.shown_area = static_cast<double>(result.counts.object_voxels) * voxel * voxel;
+  return o;
+}
+
+PerceptionObserver::PerceptionObserver(const PerceptionSettings& settings) : perception_(settings) {}
+
+Observation PerceptionObserver::observe(const RgbdFrame& frame) {
+  last_ = perception_.process(frame);
+  return observation(last_, perception_.settings().supervoxels.voxel_resolution);
+}
+
+const SettingsTable<PerceptionSettings>& perception_settings_table() {
+  using P = PerceptionSettings;
+  static const SettingsTable<P> table = [] {
+    const P d;
+    SettingsTable<P> t;
+    t.add({"beyond_view", "bool", format_bool(d.beyond_view), "",
+           "the front end (perception full or labels): an occluder the image border cuts goes on beyond it, to the "
+           "sphere (false: only what the frame shows)"},
+          [](P& p, const std::string& v) { p.beyond_view = parse_bool("beyond_view", v); },
+          [](const P& p) { return format_bool(p.beyond_view); });
+    t.add({"behind_occluders", "bool", format_bool(d.behind_occluders), "",
+           "the front end (perception full or labels): when an occluder cuts the object in the first frame, the object "
+           "goes on behind it (false: only what has been seen)"},
+          [](P& p, const std::string& v) { p.behind_occluders = parse_bool("behind_occluders", v); },
+          [](const P& p) { return format_bool(p.behind_occluders); });
+    return t;
+  }();
+  return table;
 }
 
 const char* to_string(TrackingStatus status) {
@@ -55,8 +93,8 @@ bool positive(double x) { return std::isfinite(x) && x > 0.0; }
 
 }  // namespace
 
-PerceptionSettings perception_settings(const EstimatorSettings& estimator) {
-  PerceptionSettings ps;
+PerceptionSettings perception_settings(const EstimatorSettings& estimator, PerceptionSettings base) {
+  PerceptionSettings ps = std::move(base);
   ps.r_sphere = estimator.r_sphere;
   ps.supervoxels.seed_resolution = estimator.r_seed;
   return ps;

@@ -157,7 +157,7 @@ TEST(LiveDisplay, WindowsShowTheDrawingsAtTheProjectedCentroid) {
       run_episode(setup, [&](const StepRecord& rec, const StepDetail& d) {
         ASSERT_TRUE(display.observe(rec, d));
         last = rec;
-        occluded_frames += d.problem && d.problem->occluders.cols() > 0 ? 1 : 0;
+        occluded_frames += d.observation->problem && d.observation->problem->occluders.cols() > 0 ? 1 : 0;
       });
   ASSERT_GT(occluded_frames, 0);
 

@@ -201,7 +201,8 @@ FaultRun replay(const FaultPlan& plan) {
   options.max_duration = plan.max_duration;
   FaultRun out;
   try {
-    out.summary = run_on_robot(source, robot, rec.setup.loop, options, [&](const RobotLoopFrame& f) {
+    PerceptionObserver perception(front_end_settings(rec.setup));
+    out.summary = run_on_robot(source, perception, robot, rec.setup.loop, options, [&](const RobotLoopFrame& f) {
       out.actions.push_back(f.step->safety);
       out.statuses.push_back(f.step->status);
       if (f.index == plan.observer_throws_at) throw std::runtime_error("observer fault");

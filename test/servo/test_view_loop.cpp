@@ -1,6 +1,7 @@
 // ViewLoop (the per-frame policy) and run_on_robot (its driver on robots):
 // statuses, the safety filter in the loop, stale frames, the stop flag.
 #include "ofv/servo/robot_loop.h"
+#include "ofv/servo/target_pose.h"
 #include "ofv/servo/view_loop.h"
 
 #include <gtest/gtest.h>
@@ -25,6 +26,35 @@ ViewProblem patch(bool occluded) {
   return p;
 }
 
+// The loop's input from a problem (std::nullopt: lost), the camera pose, the
+// frame's age, the shown area and how many of the problem's occluders (the
+// last ones) are presumed.
+Observation observed(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double age,
+                     std::optional<double> shown = std::nullopt, Eigen::Index presumed = 0) {
+  Observation o;
+  o.wMc = to_eigen(wMc);
+  o.age = age;
+  o.shown_area = shown;
+  if (problem) {
+    const Eigen::Index n = problem->occluders.cols();
+    presumed = std::min(presumed, n);
+    o.presumed = problem->occluders.rightCols(presumed);
+    problem->occluders = Eigen::Matrix3Xd(problem->occluders.leftCols(n - presumed));
+  }
+  o.problem = std::move(problem);
+  return o;
+}
+
+// Observes `problem` on every frame (std::nullopt: lost).
+class Fixed : public Observer {
+ public:
+  explicit Fixed(std::optional<ViewProblem> problem) : problem_(std::move(problem)) {}
+  Observation observe(const RgbdFrame& frame) override { return observed(problem_, to_visp(frame.wMc), 0.0); }
+
+ private:
+  std::optional<ViewProblem> problem_;
+};
+
 double speed(const vpColVector& v) { return std::hypot(v[0], v[1], v[2]); }
 
 TEST(ViewLoop, StatusesAndTheSafetyFilterInTheLoop) {
@@ -32,10 +62,10 @@ TEST(ViewLoop, StatusesAndTheSafetyFilterInTheLoop) {
   ViewLoop loop(settings);
   const vpHomogeneousMatrix wMc;  // at the origin, looking along +z at the patch
   const double dt = 1.0 / 30.0;
-  LoopStep s = loop.step(patch(false), wMc, dt, 0.0);
+  LoopStep s = loop.step(observed(patch(false), wMc, 0.0), dt);
   EXPECT_EQ(s.status, StepStatus::NoOccluders);
   ASSERT_TRUE(s.target);
-  s = loop.step(patch(true), wMc, dt, 0.0);
+  s = loop.step(observed(patch(true), wMc, 0.0), dt);
   EXPECT_EQ(s.status, StepStatus::Converged);
   EXPECT_GT(s.estimate->iterations, 0);
   // From rest the command is cut to what the acceleration limit allows.
@@ -43,21 +73,21 @@ TEST(ViewLoop, StatusesAndTheSafetyFilterInTheLoop) {
   EXPECT_EQ(s.safety, SafetyAction::AccelerationLimit);
   EXPECT_LE(speed(s.velocity), 2.0 * settings.safety.max_linear_accel * dt + 1e-12);
   // A lost object or a stale frame stops the robot at once.
-  s = loop.step(std::nullopt, wMc, dt, 0.0);
+  s = loop.step(observed(std::nullopt, wMc, 0.0), dt);
   EXPECT_EQ(s.status, StepStatus::ObjectLost);
   EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
-  s = loop.step(patch(true), wMc, dt, 5.0);
+  s = loop.step(observed(patch(true), wMc, 5.0), dt);
   EXPECT_EQ(s.safety, SafetyAction::StaleFrame);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
   // No usable supervoxel is a lost object, not an exception.
   ViewProblem broken = patch(true);
   broken.normals.setZero();
-  EXPECT_EQ(loop.step(broken, wMc, dt, 0.0).status, StepStatus::ObjectLost);
+  EXPECT_EQ(loop.step(observed(broken, wMc, 0.0), dt).status, StepStatus::ObjectLost);
   // The static baseline never moves.
   settings.method = ViewMethod::Static;
   ViewLoop still(settings);
-  EXPECT_EQ(still.step(patch(true), wMc, dt, 0.0).velocity.frobeniusNorm(), 0.0);
+  EXPECT_EQ(still.step(observed(patch(true), wMc, 0.0), dt).velocity.frobeniusNorm(), 0.0);
 }
 
 // The first frame whose target is more than 1 cm from t0 (the origin), as an
@@ -73,7 +103,7 @@ int first_move(Anticipation anticipation) {
     ViewProblem p = patch(false);
     p.occluders.resize(3, 9);
     for (int i = 0; i < 9; ++i) p.occluders.col(i) << -0.35 + 0.6 * k * dt + (i % 3) * 0.01, (i / 3 - 1) * 0.01, 0.3;
-    const LoopStep s = loop.step(p, wMc, dt, 0.0);
+    const LoopStep s = loop.step(observed(p, wMc, 0.0), dt);
     if (s.target && s.target->norm() > 0.01) return k;
   }
   return -1;
@@ -103,14 +133,14 @@ TEST(ViewLoop, WithoutAFreeViewItHoldsStill) {
   settings.no_free_view.mode = NoFreeView::BestIterate;
   ViewLoop wander(settings);
   const vpHomogeneousMatrix wMc;
-  const LoopStep w = wander.step(caged, wMc, 1.0 / 30.0, 0.0);
+  const LoopStep w = wander.step(observed(caged, wMc, 0.0), 1.0 / 30.0);
   ASSERT_EQ(w.status, StepStatus::NotConverged);
   ASSERT_TRUE(w.target);
   EXPECT_GT(w.target->norm(), 1e-3);
   settings.no_free_view.mode = NoFreeView::MostVisible;
   ViewLoop hold(settings);
   for (int k = 0; k < 3; ++k) {
-    const LoopStep h = hold.step(caged, wMc, 1.0 / 30.0, 0.0);
+    const LoopStep h = hold.step(observed(caged, wMc, 0.0), 1.0 / 30.0);
     ASSERT_TRUE(h.target);
     EXPECT_LT(h.target->norm(), 1e-9);
     EXPECT_LT(speed(h.velocity), 1e-9);
@@ -141,13 +171,13 @@ ViewProblem occluded_patch(double side = 1.0) {
 // `frames` frames at the origin showing 100; returns the last target.
 Eigen::Vector3d stay(ViewLoop& loop, int frames, double side = 1.0) {
   LoopStep s;
-  for (int k = 0; k < frames; ++k) s = loop.step(occluded_patch(side), vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, 100.0);
+  for (int k = 0; k < frames; ++k) s = loop.step(observed(occluded_patch(side), vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);
   EXPECT_TRUE(s.target);
   return s.target.value_or(Eigen::Vector3d::Constant(NAN));
 }
 
 // A frame at the origin with nothing in front of the patch: t0 is clear.
-void see_t0_clear(ViewLoop& loop) { (void)loop.step(patch(false), vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, 100.0); }
+void see_t0_clear(ViewLoop& loop) { (void)loop.step(observed(patch(false), vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0); }
 
 // Three frames on the way to `away` showing `shown_on_way` (of 100 at the
 // origin); returns the last target.
@@ -164,8 +194,7 @@ Eigen::Vector3d leave(ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, do
     ViewProblem p = start;
     p.occluders.conservativeResize(3, 9 + 49);
     for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = cluster + spacing * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
-    s = loop.step(p, vpHomogeneousMatrix(vpTranslationVector(camera.x(), camera.y(), camera.z()), vpRotationMatrix()),
-                  1.0 / 30.0, 0.0, shown_on_way);
+    s = loop.step(observed(p, vpHomogeneousMatrix(vpTranslationVector(camera.x(), camera.y(), camera.z()), vpRotationMatrix()), 0.0, shown_on_way), 1.0 / 30.0);
     EXPECT_TRUE(s.target);
   }
   return s.target.value_or(Eigen::Vector3d::Constant(NAN));
@@ -214,7 +243,7 @@ int retreats_after_an_arrival(bool seen_before = true, double way = 0.1) {
       p.occluders.conservativeResize(3, 9 + 49);
       for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = *cluster + 0.006 * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
     }
-    return loop.step(p, at(camera), dt, 0.0, shown);
+    return loop.step(observed(p, at(camera), 0.0, shown), dt);
   };
   Eigen::Vector3d away = stay(loop, 1).normalized();
   // On the line of sight from where the camera stops (8 cm along `away`),
@@ -260,15 +289,15 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   LoopSettings settings;
   ViewLoop loop(settings);
   (void)stay(loop, 1);
-  (void)loop.step(occluded_patch(), at(away), dt, 0.0, 95.0);
-  LoopStep s = loop.step(std::nullopt, at(away), dt, 0.0);
+  (void)loop.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
+  LoopStep s = loop.step(observed(std::nullopt, at(away), 0.0), dt);
   EXPECT_EQ(s.status, StepStatus::ObjectLost);
   ASSERT_TRUE(s.target);
   EXPECT_LT(s.target->norm(), 1e-12);
   EXPECT_NE(s.safety, SafetyAction::ObjectLost);
   EXPECT_LT(s.velocity[0], -1e-3);  // camera frame = world frame here: towards the origin
   EXPECT_LE(speed(s.velocity), settings.safety.max_linear_speed + 1e-12);
-  s = loop.step(std::nullopt, at(Eigen::Vector3d(0.005, 0, 0)), dt, 0.0);
+  s = loop.step(observed(std::nullopt, at(Eigen::Vector3d(0.005, 0, 0)), 0.0), dt);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
@@ -278,14 +307,14 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   settings.no_free_view.retreat_drop = 0.0;
   ViewLoop no_retreat(settings);
   (void)stay(no_retreat, 1);
-  (void)no_retreat.step(occluded_patch(), at(away), dt, 0.0, 95.0);
-  s = no_retreat.step(std::nullopt, at(away), dt, 0.0);
+  (void)no_retreat.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
+  s = no_retreat.step(observed(std::nullopt, at(away), 0.0), dt);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
   ViewLoop late(LoopSettings{});
   (void)stay(late, 1);
-  for (int k = 0; k < 20; ++k) (void)late.step(occluded_patch(), at(away), dt, 0.0, 95.0);
-  s = late.step(std::nullopt, at(away), dt, 0.0);
+  for (int k = 0; k < 20; ++k) (void)late.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
+  s = late.step(observed(std::nullopt, at(away), 0.0), dt);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
 }
@@ -304,8 +333,8 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
   ViewLoop with(LoopSettings{}), all(LoopSettings{});
   LoopStep a, b;
   for (int k = 0; k < 3; ++k) {
-    a = with.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, std::nullopt, 30);
-    b = all.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0);
+    a = with.step(observed(p, vpHomogeneousMatrix(), 0.0, std::nullopt, 30), 1.0 / 30.0);
+    b = all.step(observed(p, vpHomogeneousMatrix(), 0.0), 1.0 / 30.0);
   }
   EXPECT_EQ(tracked_points(a), 9);
   EXPECT_EQ(tracked_points(b), 39);
@@ -314,7 +343,7 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
   ASSERT_TRUE(a.estimate && b.estimate);
   EXPECT_EQ(a.estimate->occlusion_points, b.estimate->occlusion_points);
   // More than the problem holds is all of it.
-  const LoopStep c = with.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, std::nullopt, 1000);
+  const LoopStep c = with.step(observed(p, vpHomogeneousMatrix(), 0.0, std::nullopt, 1000), 1.0 / 30.0);
   EXPECT_EQ(tracked_points(c), 0);
   EXPECT_EQ(c.presumed_occluders, 39);
 }
@@ -394,7 +423,7 @@ Post with_a_post(double along, double side, bool t0_was_clear = false) {
     settings.no_free_view.look_ahead = look_ahead;
     ViewLoop loop(settings);
     if (t0_was_clear) see_t0_clear(loop);
-    const LoopStep s = loop.step(p, vpHomogeneousMatrix(), 1.0 / 30.0, 0.0, 100.0);
+    const LoopStep s = loop.step(observed(p, vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);
     EXPECT_TRUE(s.target);
     return s.target.value_or(Eigen::Vector3d::Constant(NAN));
   };
@@ -436,7 +465,7 @@ TEST(ViewLoop, SettingsByNameAreValidated) {
   }
 }
 
-// Frames with given timestamps; the problem comes from RobotLoopOptions::problem_source.
+// Frames with given timestamps (the problem comes from a Fixed observer).
 class Timestamps : public FrameSource {
  public:
   explicit Timestamps(std::deque<double> t) : t_(std::move(t)) {}
@@ -457,11 +486,12 @@ TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
   Timestamps source({0.0, 1.0 / 30, 2.0 / 30, 5.0, 5.0 + 1.0 / 30});
   FreeFlyingCamera robot{vpHomogeneousMatrix()};
   RobotLoopOptions options;
-  options.problem_source = [](const RgbdFrame&) { return std::optional<ViewProblem>(patch(true)); };
+  Fixed observer(patch(true));
   std::vector<SafetyAction> actions;
-  const RobotLoopSummary summary = run_on_robot(source, robot, LoopSettings{}, options, [&](const RobotLoopFrame& f) {
+  const RobotLoopSummary summary = run_on_robot(source, observer, robot, LoopSettings{}, options, [&](const RobotLoopFrame& f) {
     actions.push_back(f.step->safety);
-    EXPECT_EQ(f.perception, nullptr);
+    ASSERT_NE(f.observation, nullptr);
+    EXPECT_DOUBLE_EQ(f.observation->age, f.frame_age);
   });
   EXPECT_EQ(summary.frames, 5);
   EXPECT_EQ(summary.lost, 0);
@@ -476,14 +506,14 @@ TEST(RobotLoop, TheStopFlagEndsTheRunAndMaxDurationTheSource) {
   Timestamps source({0.0, 0.1, 0.2});
   FreeFlyingCamera robot{vpHomogeneousMatrix()};
   RobotLoopOptions options;
-  options.problem_source = [](const RgbdFrame&) { return std::optional<ViewProblem>(patch(false)); };
+  Fixed observer(patch(false));
   options.stop = &stop;
-  RobotLoopSummary summary = run_on_robot(source, robot, LoopSettings{}, options);
+  RobotLoopSummary summary = run_on_robot(source, observer, robot, LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 0);
   EXPECT_TRUE(summary.stopped);
   stop = 0;
   options.max_duration = 0.15;
-  summary = run_on_robot(source, robot, LoopSettings{}, options);
+  summary = run_on_robot(source, observer, robot, LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 2);  // 0 and 0.1 s; the frame at 0.2 s is past the duration
   EXPECT_FALSE(summary.stopped);
 }

@@ -23,8 +23,10 @@
 #pragma once
 
 #include "ofv/estimator.h"
+#include "ofv/observation.h"
 #include "ofv/perception/cloud.h"
 #include "ofv/rgbd_frame.h"
+#include "ofv/settings_table.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -265,9 +267,14 @@ struct PerceptionResult {
   std::string message;  ///< why the object is lost, when it is
 };
 
-/// \brief How much of the object the frame shows: its voxels seen in the
-///        frame (ofv::ViewLoop::step's `shown`); std::nullopt when the object is lost.
-[[nodiscard]] std::optional<double> shown_object(const PerceptionResult& result);
+/**
+ * \brief What a result tells the loop: the problem (none when the object is
+ *        lost) with the occluders seen in the frame, the ones beyond the
+ *        image border as presumed, and the object's voxels seen in the frame
+ *        times a voxel's face as the shown area [m²]. Its age is left 0.
+ * \param voxel the front end's voxel edge (SupervoxelSettings::voxel_resolution) [m]
+ */
+[[nodiscard]] Observation observation(const PerceptionResult& result, double voxel);
 
 [[nodiscard]] const char* to_string(TrackingStatus status);
 [[nodiscard]] const char* to_string(SupervoxelClass label);
@@ -279,8 +286,13 @@ struct PerceptionResult {
 void validate(const PerceptionSettings& settings);
 
 /// \brief The front end's settings for an estimator: its r_sphere and, as
-///        the supervoxel seed resolution, its r_seed; the rest default.
-[[nodiscard]] PerceptionSettings perception_settings(const EstimatorSettings& estimator);
+///        the supervoxel seed resolution, its r_seed; the rest from `base`.
+[[nodiscard]] PerceptionSettings perception_settings(const EstimatorSettings& estimator,
+                                                     PerceptionSettings base = {});
+
+/// \brief The front end's settings a user sets by name (`--set`, scenario
+///        files, grids): beyond_view, behind_occluders.
+[[nodiscard]] const SettingsTable<PerceptionSettings>& perception_settings_table();
 
 /**
  * \brief Follows one object through a sequence of RGB-D frames.
@@ -309,6 +321,25 @@ class Perception {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/**
+ * \brief The front end as the loop's ofv::Observer: each frame through
+ *        Perception::process, then observation(); the whole result of the
+ *        last frame stays readable (for scores, pictures and displays).
+ */
+class PerceptionObserver final : public Observer {
+ public:
+  /// \throws std::invalid_argument for invalid settings (see validate()).
+  explicit PerceptionObserver(const PerceptionSettings& settings);
+  [[nodiscard]] Observation observe(const RgbdFrame& frame) override;
+  /// \brief The front end's result of the last observe() (empty before the first).
+  [[nodiscard]] const PerceptionResult& last() const { return last_; }
+  [[nodiscard]] const PerceptionSettings& settings() const { return perception_.settings(); }
+
+ private:
+  Perception perception_;
+  PerceptionResult last_;
 };
 
 }  // namespace ofv

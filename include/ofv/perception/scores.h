@@ -118,4 +118,14 @@ struct PerceptionScores {
 [[nodiscard]] PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult& result,
                                                 const PerceptionTruth& truth, const PerceptionSettings& settings);
 
+/**
+ * \brief The object's surface a labelled frame shows [m²], in the unit of
+ *        Observation::shown_area: its voxels (the cells most of whose pixels
+ *        show the object) times a voxel's face. What a front end that
+ *        classified every pixel right would report.
+ * \param settings the front end's (voxel resolution, pixel stride, max depth).
+ * \throws std::invalid_argument when the frame has no labels.
+ */
+[[nodiscard]] double labelled_shown_area(const RgbdFrame& frame, const PerceptionSettings& settings);
+
 }  // namespace ofv

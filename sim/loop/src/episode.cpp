@@ -27,6 +27,7 @@ SettingsTable<EpisodeSetup> make_table() {
   const EpisodeSetup d;
   SettingsTable<E> t;
   t.include(loop_settings_table(), [](auto& e) -> auto& { return e.loop; });
+  t.include(perception_settings_table(), [](auto& e) -> auto& { return e.front_end; });
   t.add({"robot", "camera | viper850 | afma6", "the scenario's", "",
          "free-flying camera, or the arm on ViSP's kinematic model (threaded simulator with real_time)"},
         [](E& e, const std::string& v) { e.robot = parse_robot_kind(v); },
@@ -93,14 +94,6 @@ ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const E
   return gt_problem;
 }
 
-// The front end of an episode with full or labels perception.
-PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
-  PerceptionSettings settings = perception_settings(setup.loop.estimator.resolve());
-  settings.beyond_view = setup.loop.beyond_view;
-  settings.behind_occluders = setup.loop.behind_occluders;
-  if (setup.perception == PerceptionMode::Labels) settings.classes = PerceptionSettings::Classes::Labels;
-  return settings;
-}
 
 // The front end's output against the frame's labels and the object's true surface.
 PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, const sim::Renderer& renderer,
@@ -111,6 +104,33 @@ PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, c
   truth.surface = renderer.object_surface();
   return score_perception(frame, result, truth, settings);
 }
+
+// Ground truth as the loop sees it: the simulator's problem (every occluder
+// in the sphere, seen or not) and, as the shown area, what a front end that
+// classified every pixel right would report; no other truth.
+Observation truth_observation(const RgbdFrame& frame, ViewProblem problem, const PerceptionSettings& settings) {
+  Observation o;
+  o.wMc = frame.wMc;
+  o.problem = std::move(problem);
+  o.shown_area = labelled_shown_area(frame, settings);
+  return o;
+}
+
+// The same for frames rendered elsewhere (a live simulated sensor).
+class TruthObserver final : public Observer {
+ public:
+  TruthObserver(const sim::Renderer& renderer, const EstimatorSettings& estimator, const PerceptionSettings& settings)
+      : renderer_(renderer), estimator_(estimator), settings_(settings) {}
+  Observation observe(const RgbdFrame& frame) override {
+    return truth_observation(frame, renderer_.ground_truth_problem(frame.wMc, estimator_.r_seed, estimator_.r_sphere),
+                             settings_);
+  }
+
+ private:
+  const sim::Renderer& renderer_;
+  EstimatorSettings estimator_;
+  PerceptionSettings settings_;
+};
 
 // What the loop did.
 void record_step(StepRecord& rec, const LoopStep& step) {
@@ -154,6 +174,12 @@ long episode_frames(const EpisodeSetup& setup) {
 
 }  // namespace
 
+PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
+  PerceptionSettings settings = perception_settings(setup.loop.estimator.resolve(), setup.front_end);
+  if (setup.perception == PerceptionMode::Labels) settings.classes = PerceptionSettings::Classes::Labels;
+  return settings;
+}
+
 const char* to_string(PerceptionMode mode) {
   switch (mode) {
     case PerceptionMode::Full: return "full";
@@ -194,7 +220,8 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   ViewLoop loop(setup.loop);
   sim::Renderer renderer(scenario);
   std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
-  std::optional<Perception> perception;  // full: made on the first frame, which may point out the object
+  const PerceptionSettings front_end = front_end_settings(setup);
+  std::optional<PerceptionObserver> perception;  // full, labels: made on the first frame, which may point out the object
 
   // Commands on their way to the robot, oldest first.
   std::deque<vpColVector> in_flight(static_cast<std::size_t>(setup.latency), vpColVector(6, 0.0));
@@ -218,35 +245,26 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     rec.occluders_in_view = sim::occluders_seen(rendered.frame.labels);
 
     start = Clock::now();
-    std::optional<ViewProblem> problem;
-    std::optional<double> shown = rec.visible_fraction;  // ground truth: what the camera sees
-    Eigen::Index beyond_view = 0;
     if (setup.perception != PerceptionMode::GroundTruth && !perception) {
-      PerceptionSettings settings = front_end_settings(setup);
+      PerceptionSettings settings = front_end;
       if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.frame.labels);
       perception.emplace(settings);
     }
-    std::optional<PerceptionResult> result;
-    if (perception) {
-      result = perception->process(rendered.frame);
-      shown = shown_object(*result);
-      beyond_view = static_cast<Eigen::Index>(result->counts.beyond_view);
-      if (result->status != TrackingStatus::Lost) problem = result->problem;
-    } else {
-      problem = std::move(gt_problem);
-    }
+    Observation observation = perception ? perception->observe(rendered.frame)
+                                          : truth_observation(rendered.frame, std::move(gt_problem), front_end);
     rec.times.perception = seconds_since(start);
-    if (result) rec.perception = score(rendered.frame, *result, renderer, perception->settings());
+    if (perception) rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
 
     // The frame is as old as 1 + latency periods when its command is replaced.
-    const LoopStep step = loop.step(problem, wMc_visp, dt, dt * (1 + setup.latency), shown, beyond_view);
+    observation.age = dt * (1 + setup.latency);
+    const LoopStep step = loop.step(observation, dt);
     record_step(rec, step);
 
     outcome.steps.push_back(rec);
     if (observer) {
       StepDetail detail;
       detail.frame = &rendered.frame;
-      detail.problem = problem ? &*problem : nullptr;
+      detail.observation = &observation;
       detail.step = &step;
       observer(rec, detail);
     }
@@ -270,30 +288,31 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
   sim::LiveSource source(renderer, [&robot] { return to_eigen(robot->wMc()); }, setup.duration);
 
   RobotLoopOptions options;
-  options.classes = front_end_settings(setup).classes;
   options.wall_clock_age = true;
   options.first_period = 1.0 / setup.scenario.rate;
   options.stop = stop;
-  if (setup.perception == PerceptionMode::GroundTruth) {
-    options.problem_source = [&](const RgbdFrame& frame) -> std::optional<ViewProblem> {
-      return renderer.ground_truth_problem(frame.wMc, estimator.r_seed, estimator.r_sphere);
-    };
-  } else if (setup.select == ObjectSelect::Labels) {
+  PerceptionSettings front_end = front_end_settings(setup);
+  if (setup.perception != PerceptionMode::GroundTruth && setup.select == ObjectSelect::Labels) {
     // The first frame's labels, rendered from where the arm starts.
     sim::RenderedFrame first;
     const sim::SensorSettings& sensor = renderer.scenario().sensor;
     renderer.set_time(0.0);
     renderer.render(to_eigen(robot->wMc()), 0, sensor.intrinsics, sensor.noise.enabled, first);
-    options.selection = object_in(first.frame.labels);
+    front_end.selection = object_in(first.frame.labels);
   }
+  TruthObserver truth(renderer, estimator, front_end);
+  std::optional<PerceptionObserver> perception;
+  if (setup.perception != PerceptionMode::GroundTruth) perception.emplace(front_end);
+  Observer& observer_of_frames = perception ? static_cast<Observer&>(*perception) : truth;
+
   EpisodeOutcome outcome;
-  (void)run_on_robot(source, *robot, setup.loop, options, [&](const RobotLoopFrame& f) {
+  (void)run_on_robot(source, observer_of_frames, *robot, setup.loop, options, [&](const RobotLoopFrame& f) {
     StepRecord rec;
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;
     (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
     rec.occluders_in_view = sim::occluders_seen(f.frame->labels);
-    if (f.perception) rec.perception = score(*f.frame, *f.perception, renderer, front_end_settings(setup));
+    if (perception) rec.perception = score(*f.frame, perception->last(), renderer, front_end);
     rec.times.render = f.source_s;
     rec.times.perception = f.perception_s;
     record_step(rec, *f.step);

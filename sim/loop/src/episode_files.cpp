@@ -52,7 +52,7 @@ cv::Mat scene_picture(const StepRecord& rec, const StepDetail& d, const std::vec
   state.centroid = rec.true_centroid;
   state.visible_fraction = rec.visible_fraction;
   state.status = rec.status;
-  state.problem = d.problem;
+  state.observation = d.observation;
   state.step = d.step;
   const RgbPicture picture = ofv::scene_picture(state, path, r_sphere);
   cv::Mat rgb(picture.height, picture.width, CV_8UC3, const_cast<std::uint8_t*>(picture.rgb.data()));

@@ -43,18 +43,20 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
       prev = pt;
     }
   }
-  if (s.problem) {
-    for (Eigen::Index i = 0; i < s.problem->positions.cols(); ++i) {
-      const auto a = p(s.problem->positions.col(i));
-      const auto b = p(s.problem->positions.col(i) + 0.03 * s.problem->normals.col(i).normalized());
+  if (s.observation && s.observation->problem) {
+    const ViewProblem& problem = *s.observation->problem;
+    for (Eigen::Index i = 0; i < problem.positions.cols(); ++i) {
+      const auto a = p(problem.positions.col(i));
+      const auto b = p(problem.positions.col(i) + 0.03 * problem.normals.col(i).normalized());
       if (a) cv::circle(img, *a, 2, {255, 160, 60}, cv::FILLED);
       if (a && b) cv::line(img, *a, *b, {200, 120, 60}, 1, cv::LINE_AA);
     }
-    // Seen occluders filled; those presumed beyond the image border (last) hollow.
-    const Eigen::Index seen = s.problem->occluders.cols() - (s.step ? s.step->presumed_occluders : 0);
-    for (Eigen::Index i = 0; i < s.problem->occluders.cols(); ++i) {
-      if (const auto a = p(s.problem->occluders.col(i))) {
-        cv::rectangle(img, *a - cv::Point(2, 2), *a + cv::Point(2, 2), {60, 60, 230}, i < seen ? cv::FILLED : 1);
+    // Seen occluders filled; those presumed beyond the image border hollow.
+    const Eigen::Matrix3Xd occluders = s.observation->all_occluders();
+    for (Eigen::Index i = 0; i < occluders.cols(); ++i) {
+      if (const auto a = p(occluders.col(i))) {
+        cv::rectangle(img, *a - cv::Point(2, 2), *a + cv::Point(2, 2), {60, 60, 230},
+                      i < problem.occluders.cols() ? cv::FILLED : 1);
       }
     }
   }

@@ -102,7 +102,7 @@ struct DisplayInput {
   /// The camera image; nullptr: a grey image of `intrinsics` (a loop without a sensor).
   const RgbdFrame* frame = nullptr;
   CameraIntrinsics intrinsics;           ///< used when `frame` is nullptr
-  const ViewProblem* problem = nullptr;  ///< supervoxels and occluders (nullptr: object lost)
+  const Observation* observation = nullptr;  ///< supervoxels and occluders seen and presumed (nullptr: none)
   const LoopStep* step = nullptr;  ///< what ofv::ViewLoop did (nullptr: a loop of the caller's own)
   /// The object's centroid when the step has no estimate (simulation: the true one).
   std::optional<Eigen::Vector3d> centroid;

@@ -1,14 +1,14 @@
 /**
  * \file robot_loop.h
  * \brief The closed loop on a robot: frames from a sensor or a recording →
- *        perception → ofv::ViewLoop → the robot, until the source ends or a
- *        stop is requested. `ofv run`, the rehearsal on ViSP's threaded
+ *        an ofv::Observer (the perception front end, ofv::PerceptionObserver)
+ *        → ofv::ViewLoop → the robot, until the source ends or a stop is requested. `ofv run`, the rehearsal on ViSP's threaded
  *        simulators and the real-robot tutorial use it.
  */
 #pragma once
 
 #include "ofv/frame_source.h"
-#include "ofv/perception/perception.h"
+#include "ofv/observation.h"
 #include "ofv/servo/robot.h"
 #include "ofv/servo/view_loop.h"
 
@@ -36,28 +36,18 @@ struct RobotLoopOptions {
   double first_period = 1.0 / 30.0;
   /// When set, stop as soon as it reads non-zero (a signal handler's flag).
   const volatile std::sig_atomic_t* stop = nullptr;
-  /// How perception finds the object in the first frame (a world box, an
-  /// image rectangle or mask); the default is the front end's own choice,
-  /// the cluster nearest the image centre.
-  ObjectSelection selection;
-  /// Where perception's classes come from: the front end's segmentation,
-  /// or the frames' labels (frames that carry them: PerceptionSettings::Classes).
-  PerceptionSettings::Classes classes = PerceptionSettings::Classes::Segmentation;
-  /// When set, the estimator's input comes from here instead of the
-  /// perception front end (simulated ground truth); std::nullopt = lost.
-  std::function<std::optional<ViewProblem>(const RgbdFrame&)> problem_source;
 };
 
 /// \brief One frame of run_on_robot(), for printing and recording.
 struct RobotLoopFrame {
   long index = 0;
   const RgbdFrame* frame = nullptr;
-  const PerceptionResult* perception = nullptr;  ///< nullptr with a problem_source
+  const Observation* observation = nullptr;  ///< what the loop was given (its age set)
   const LoopStep* step = nullptr;
   double dt = 0.0;         ///< period the command is applied for [s] (0 with a timestamp that does not increase)
   double frame_age = 0.0;  ///< [s]
   double source_s = 0.0;      ///< time spent waiting for and reading the frame [s]
-  double perception_s = 0.0;  ///< compute time of perception [s]
+  double perception_s = 0.0;  ///< compute time of the observer (perception) [s]
 };
 
 /// \brief How a run ended.
@@ -76,11 +66,14 @@ struct RobotLoopSummary {
  * or is not finite, or a lost object gives a zero velocity for that frame;
  * the robot is never sent a period that is not finite and >= 0 (0 with
  * such a stop), and a non-finite timestamp is not the next frame's time base.
+ * \param observer makes each frame's observation (ofv::PerceptionObserver on
+ *                 a sensor; in a rehearsal, the simulator's cut-down truth).
+ * \param on_frame sees every frame after its command is sent; may be empty.
  * \throws std::invalid_argument for invalid settings; whatever the source,
- *         perception or robot throw at run time.
+ *         observer or robot throw at run time.
  */
-RobotLoopSummary run_on_robot(FrameSource& source, CameraRobot& robot, const LoopSettings& settings,
-                              const RobotLoopOptions& options,
-                              const std::function<void(const RobotLoopFrame&)>& observer = {});
+RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
+                              const LoopSettings& settings, const RobotLoopOptions& options,
+                              const std::function<void(const RobotLoopFrame&)>& on_frame = {});
 
 }  // namespace ofv

@@ -7,15 +7,17 @@
  *
  * Every caller uses it: the simulated episode (ofv::run_episode), `ofv run`
  * on hardware or recordings (ofv::run_on_robot), the tutorials. Perception
- * (or the simulator's ground truth) comes before it, the robot after it.
+ * (or the simulator's ground truth) comes before it as an ofv::Observation,
+ * the robot after it.
  *
  * \code
  * ofv::LoopSettings settings;                      // documented defaults
  * ofv::loop_settings_table().set(settings, "gain", "6");
  * ofv::ViewLoop loop(settings);
  * while (...) {
- *   std::optional<ofv::ViewProblem> problem = ...;  // nullopt when the object is lost
- *   const ofv::LoopStep s = loop.step(std::move(problem), robot.wMc(), dt, frame_age);
+ *   ofv::Observation seen = observer.observe(frame);  // ofv::PerceptionObserver, or your own
+ *   seen.age = frame_age;
+ *   const ofv::LoopStep s = loop.step(seen, dt);
  *   robot.step(s.velocity, dt);
  * }
  * \endcode
@@ -23,6 +25,7 @@
 #pragma once
 
 #include "ofv/estimator.h"
+#include "ofv/observation.h"
 #include "ofv/occluder_tracker.h"
 #include "ofv/servo/controller.h"
 #include "ofv/servo/loop_status.h"
@@ -86,11 +89,6 @@ struct LoopSettings {
   /// view; once t0 is clear again, t0 is the target. The sampling planner
   /// keeps its previous view while it sees as much as the new best.
   bool target_hysteresis = true;
-  /// The front end's PerceptionSettings::beyond_view, where the loop makes
-  /// the front end (simulation with perception=full, ofv::run_on_robot).
-  bool beyond_view = true;
-  /// The front end's PerceptionSettings::behind_occluders, likewise.
-  bool behind_occluders = true;
   AnticipationSettings anticipation;
   TrackerSettings tracker;           ///< the occluder tracks anticipation uses
   NoFreeViewSettings no_free_view;   ///< what to do when the estimator finds no free view
@@ -121,8 +119,7 @@ struct LoopStep {
   /// previous target.
   std::optional<ViewEstimate> anticipated;
   Eigen::Index predicted_occluders = 0;  ///< predicted points added to the problem
-  /// The problem's last this many occluders were presumed, not seen
-  /// (step()'s `untracked`: perception's continuation beyond the image border).
+  /// Occluders presumed, not seen (Observation::presumed).
   Eigen::Index presumed_occluders = 0;
   double estimate_s = 0.0;  ///< compute time of view selection [s]
   double control_s = 0.0;   ///< compute time of controller and filter [s]
@@ -139,28 +136,18 @@ class ViewLoop {
   explicit ViewLoop(const LoopSettings& settings);
 
   /**
-   * \param problem   the frame's estimator input (world frame), or std::nullopt
-   *                  when perception lost the object. Its camera and
-   *                  previous_view are set by the loop.
-   * \param wMc       camera pose when the frame was taken.
+   * \param observation what the frame shows (ofv::Observer): the problem
+   *                  (none when the object is lost; its camera and
+   *                  previous_view are set here), the presumed occluders
+   *                  (the estimator avoids them, the occluder tracks leave
+   *                  them out), the shown area (unknown: the loop never
+   *                  retreats, NoFreeViewSettings::retreat_drop), the camera
+   *                  pose when the frame was taken and the frame's age when
+   *                  the command is sent (older than the stale timeout: stop).
    * \param dt        time since the previous frame, and the period the command
    *                  will be applied for [s].
-   * \param frame_age how old the frame is when the command is sent [s]
-   *                  (older than the stale timeout: stop).
-   * \param shown     how much of the object the frame shows, in any unit
-   *                  that does not depend on the view (perception:
-   *                  ofv::shown_object(), its voxels seen in the frame), or
-   *                  std::nullopt when unknown: then the loop never
-   *                  retreats (NoFreeViewSettings::retreat_drop).
-   * \param untracked  the last this many columns of the problem's occluders
-   *                  are presumed, not seen (perception's continuation
-   *                  beyond the image border, PerceptionCounts::beyond_view):
-   *                  the estimator avoids them, the occluder tracks leave
-   *                  them out.
    */
-  [[nodiscard]] LoopStep step(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double dt,
-                              double frame_age, std::optional<double> shown = std::nullopt,
-                              Eigen::Index untracked = 0);
+  [[nodiscard]] LoopStep step(const Observation& observation, double dt);
 
   /// \brief Forgets the previous view, target and command (a new run).
   void reset();

@@ -1,7 +1,8 @@
 /**
  * \file episode.h
  * \brief One closed-loop episode: render the frame at the camera's pose →
- *        perception (full, or ground truth) → ofv::ViewLoop (view selection,
+ *        an ofv::Observation (perception full or labels, or the ground truth
+ *        cut down to what a front end gives) → ofv::ViewLoop (view selection,
  *        controller, safety filter) → the robot moves one frame period →
  *        next frame. Deterministic for a scenario, settings and seed.
  */
@@ -10,6 +11,7 @@
 #include "ofv/estimator.h"
 #include "ofv/loop/compare.h"
 #include "ofv/loop/metrics.h"
+#include "ofv/perception/perception.h"
 #include "ofv/rgbd_frame.h"
 #include "ofv/servo/robot.h"
 #include "ofv/servo/robot_loop.h"
@@ -59,6 +61,10 @@ struct EpisodeSetup {
   LoopSettings loop;  ///< the per-frame policy: estimator, method, controller, safety
   RobotKind robot = RobotKind::Camera;
   PerceptionMode perception = PerceptionMode::Full;
+  /// The front end's settings (perception full or labels) that users set
+  /// (ofv::perception_settings_table()); its sphere and seed resolution
+  /// come from the estimator's.
+  PerceptionSettings front_end;
   ObjectSelect select = ObjectSelect::Labels;  ///< full perception, simulation only
   double duration = 0.0;  ///< [s]
   unsigned seed = 0;      ///< the scenario's k-th random world (sim::with_seed)
@@ -74,8 +80,9 @@ struct EpisodeSetup {
 
 /**
  * \brief Every setting of an episode by name: the loop's
- *        (ofv::loop_settings_table()) and robot, perception, select, duration,
- *        seed, latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        (ofv::loop_settings_table()), the front end's
+ *        (ofv::perception_settings_table()) and robot, perception, select,
+ *        duration, seed, latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
 [[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();
@@ -89,10 +96,15 @@ struct EpisodeSetup {
 [[nodiscard]] EpisodeSetup resolve_episode(
     const sim::Scenario& scenario, const std::vector<std::pair<std::string, std::string>>& settings);
 
+/// \brief The front end's settings of an episode: the estimator's sphere
+///        and seed resolution, the setup's front_end, labels as classes with
+///        perception=labels (the object selection left as the default).
+[[nodiscard]] PerceptionSettings front_end_settings(const EpisodeSetup& setup);
+
 /// \brief What happened in one step, for pictures and progress.
 struct StepDetail {
   const RgbdFrame* frame = nullptr;         ///< the rendered frame
-  const ViewProblem* problem = nullptr;     ///< the estimator's input (nullptr when lost)
+  const Observation* observation = nullptr;  ///< what the loop was given
   const LoopStep* step = nullptr;           ///< what the loop did (estimate, target, velocities)
 };
 

@@ -36,7 +36,7 @@ struct SceneState {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::optional<double> visible_fraction;  ///< the true visible fraction (simulation only)
   std::optional<StepStatus> status;        ///< the loop's status (none: a loop of the caller's own)
-  const ViewProblem* problem = nullptr;    ///< supervoxels and occluders; nullptr when lost
+  const Observation* observation = nullptr;  ///< supervoxels, occluders seen and presumed; nullptr: none
   const LoopStep* step = nullptr;          ///< estimate, target, tracks; nullptr when none
   /// The target when there is no step (a caller's own servo loop).
   std::optional<Eigen::Vector3d> target;

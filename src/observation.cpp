@@ -1,0 +1,14 @@
+// The loop's input from one frame.
+#include "ofv/observation.h"
+
+namespace ofv {
+
+Eigen::Matrix3Xd Observation::all_occluders() const {
+  const Eigen::Index seen = problem ? problem->occluders.cols() : 0;
+  Eigen::Matrix3Xd all(3, seen + presumed.cols());
+  if (seen > 0) all.leftCols(seen) = problem->occluders;
+  all.rightCols(presumed.cols()) = presumed;
+  return all;
+}
+
+}  // namespace ofv
