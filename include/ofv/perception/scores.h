@@ -65,6 +65,8 @@ class VoxelLabels {
     std::uint16_t label = kPixelNone;                ///< the label most of them show
   };
 
+  /// \brief The voxel grid of `frame`'s labelled pixels.
+  /// \param frame  a frame with labels
   /// \param voxel  edge of the cells [m] (> 0)
   /// \param stride every stride-th pixel in u and v (>= 1), as CloudSettings::pixel_stride
   /// \param max_depth pixels farther along the optical axis are left out [m]
@@ -78,6 +80,7 @@ class VoxelLabels {
   /// \brief The label of find(p); kPixelNone when there is no cell.
   [[nodiscard]] std::uint16_t label_at(const Eigen::Vector3f& p) const;
 
+  /// \brief The occupied cells, indexed as find() returns them.
   [[nodiscard]] const std::vector<Cell>& cells() const { return cells_; }
 
  private:
@@ -99,10 +102,10 @@ struct PerceptionTruth {
 
 /// \brief One frame's perception scores (see the file's description).
 struct PerceptionScores {
-  std::optional<double> object_precision;
-  std::optional<double> object_recall;
-  std::optional<double> occluder_precision;
-  std::optional<double> occluder_recall;
+  std::optional<double> object_precision;    ///< of the voxels called object, the fraction that is object
+  std::optional<double> object_recall;       ///< of the object cells shown, the fraction found as object
+  std::optional<double> occluder_precision;  ///< of the voxels called occluder (support left out), the fraction that is an occluding body
+  std::optional<double> occluder_recall;     ///< of the occluding bodies' cells in the sphere, the fraction found as occluder
   std::optional<double> centroid_error;  ///< [m]
   std::optional<double> hidden_error;    ///< mean over the hidden voxels [m]
   std::size_t object_cells = 0;    ///< object cells the frame shows (recall's denominator)
@@ -112,6 +115,9 @@ struct PerceptionScores {
 
 /**
  * \brief Scores the front end's result on a labelled frame.
+ * \param frame    the frame the front end processed, with its labels.
+ * \param result   what Perception::process() returned for it.
+ * \param truth    the true centroid and surface, where known.
  * \param settings the front end's (voxel resolution, pixel stride, max depth).
  * \throws std::invalid_argument when the frame has no labels.
  */
