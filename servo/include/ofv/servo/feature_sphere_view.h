@@ -59,6 +59,7 @@ namespace ofv {
 /// \brief The sphere-view feature (see the file documentation for L_s).
 class FeatureSphereView : public vpBasicFeature {
  public:
+  /// \brief A feature of dimension 6 with s = 0; build() sets its state.
   FeatureSphereView();
 
   /**
@@ -74,17 +75,23 @@ class FeatureSphereView : public vpBasicFeature {
 
   /// Selectors of the components, for interaction() and error().
   static unsigned int selectX();
-  static unsigned int selectY();
-  static unsigned int selectRho();
+  static unsigned int selectY();    ///< y = c_y / c_z, the vertical image coordinate of C
+  static unsigned int selectRho();  ///< rho - R, the distance from C off the sphere
   static unsigned int selectTangent();  ///< the three components of e
 
+  /// \brief Resets it to dimension 6, s = 0, not built (vpBasicFeature's contract).
   void init() override;
+  /// \brief The rows of L_s (file documentation) that `select` picks.
+  /// \throws std::logic_error when build() was not called.
   vpMatrix interaction(unsigned int select = FEATURE_ALL) override;
+  /// \brief Prints the selected components of s (x, y, rho-R, f_x, f_y, f_z) to std::cout.
   void print(unsigned int select = FEATURE_ALL) const override;
+  /// \brief A copy allocated with new (vpServo owns it).
   FeatureSphereView* duplicate() const override;
   /// Draws the projection of C (the centring part of the feature).
   void display(const vpCameraParameters& cam, const vpImage<unsigned char>& I,
                const vpColor& color = vpColor::green, unsigned int thickness = 1) const override;
+  /// Draws the projection of C on a colour image.
   void display(const vpCameraParameters& cam, const vpImage<vpRGBa>& I,
                const vpColor& color = vpColor::green, unsigned int thickness = 1) const override;
 
