@@ -26,11 +26,12 @@
  * not depend on the camera's orientation), the interaction matrix
  * \f$ \dot{\mathbf{s}} = \mathbf{L}_s \mathbf{v} \f$ is
  * \f[ \mathbf{L}_s = \begin{bmatrix}
- *   -1/c_z & 0 & x/c_z & xy & -(1+x^2) & y \\
- *   0 & -1/c_z & y/c_z & 1+y^2 & -xy & -x \\
- *   \multicolumn{3}{c}{\mathbf{d}^\top} & 0 & 0 & 0 \\
- *   \multicolumn{3}{c}{-{}^w\mathbf{R}_c \mathbf{P} / \rho} & \multicolumn{3}{c}{\mathbf{0}}
- * \end{bmatrix}. \f]
+ *   \mathbf{L}_{xy,\upsilon} & \mathbf{L}_{xy,\omega} \\
+ *   \mathbf{d}^\top & \mathbf{0}_{1\times3} \\
+ *   -{}^w\mathbf{R}_c \mathbf{P} / \rho & \mathbf{0}_{3\times3}
+ * \end{bmatrix},\quad
+ * \mathbf{L}_{xy,\upsilon} = \begin{bmatrix} -1/c_z & 0 & x/c_z \\ 0 & -1/c_z & y/c_z \end{bmatrix},\quad
+ * \mathbf{L}_{xy,\omega} = \begin{bmatrix} xy & -(1+x^2) & y \\ 1+y^2 & -xy & -x \end{bmatrix}. \f]
  * The translation it asks for is tangent to the sphere (through P) plus a
  * radial term that holds ρ at R, so the camera travels along the sphere, not
  * along the chord through the occluders; the rotation only centres C. L has
