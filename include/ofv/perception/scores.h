@@ -102,10 +102,16 @@ struct PerceptionTruth {
 
 /// \brief One frame's perception scores (see the file's description).
 struct PerceptionScores {
-  std::optional<double> object_precision;    ///< of the voxels called object, the fraction that is object
-  std::optional<double> object_recall;       ///< of the object cells shown, the fraction found as object
-  std::optional<double> occluder_precision;  ///< of the voxels called occluder (support left out), the fraction that is an occluding body
-  std::optional<double> occluder_recall;     ///< of the occluding bodies' cells in the sphere, the fraction found as occluder
+  /// Of the voxels called object, the fraction whose cell is object.
+  std::optional<double> object_precision;
+  /// Of the object cells the frame shows, the fraction found as object.
+  std::optional<double> object_recall;
+  /// Of the voxels called occluder (the support's left out), the fraction
+  /// whose cell is an occluding body.
+  std::optional<double> occluder_precision;
+  /// Of the occluding bodies' cells within r_sphere of the true centroid,
+  /// the fraction found as occluder.
+  std::optional<double> occluder_recall;
   std::optional<double> centroid_error;  ///< [m]
   std::optional<double> hidden_error;    ///< mean over the hidden voxels [m]
   std::size_t object_cells = 0;    ///< object cells the frame shows (recall's denominator)

@@ -30,8 +30,10 @@
  *   \mathbf{d}^\top & \mathbf{0}_{1\times3} \\
  *   -{}^w\mathbf{R}_c \mathbf{P} / \rho & \mathbf{0}_{3\times3}
  * \end{bmatrix},\quad
- * \mathbf{L}_{xy,\upsilon} = \begin{bmatrix} -1/c_z & 0 & x/c_z \\ 0 & -1/c_z & y/c_z \end{bmatrix},\quad
- * \mathbf{L}_{xy,\omega} = \begin{bmatrix} xy & -(1+x^2) & y \\ 1+y^2 & -xy & -x \end{bmatrix}. \f]
+ * \mathbf{L}_{xy,\upsilon} = \begin{bmatrix} -1/c_z & 0 & x/c_z \\
+ *   0 & -1/c_z & y/c_z \end{bmatrix},\quad
+ * \mathbf{L}_{xy,\omega} = \begin{bmatrix} xy & -(1+x^2) & y \\
+ *   1+y^2 & -xy & -x \end{bmatrix}. \f]
  * The translation it asks for is tangent to the sphere (through P) plus a
  * radial term that holds ρ at R, so the camera travels along the sphere, not
  * along the chord through the occluders; the rotation only centres C. L has

@@ -42,8 +42,10 @@ struct TriangleMesh {
 [[nodiscard]] TriangleMesh make_sheet(double size_x, double size_y, double thickness, int nx, int ny);
 /// \brief Largest mesh read_mesh() reads: vertices, triangles (PLY faces) and file size.
 constexpr std::size_t kMaxMeshVertices = 5'000'000;
-constexpr std::size_t kMaxMeshTriangles = 10'000'000;  ///< most triangles (PLY faces) read_mesh() reads
-constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{512} << 20;  ///< largest file read_mesh() reads [bytes] (512 MiB)
+/// \brief Most triangles (PLY faces) read_mesh() reads.
+constexpr std::size_t kMaxMeshTriangles = 10'000'000;
+/// \brief Largest mesh file read_mesh() reads [bytes] (512 MiB).
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{512} << 20;
 
 /**
  * \brief Reads a mesh file (any format Assimp reads), scaled by `scale`.
