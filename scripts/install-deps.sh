@@ -17,6 +17,7 @@ packages=(
   xvfb xdotool  # the live display's tests (ctest -L display): windows under xvfb-run, clicks
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib  # python/: the module ofv, its tests and tutorial
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ -fsanitize=fuzzer (libFuzzer)
+  doxygen  # the API reference: cmake --build build --target doc (cmake/Doxyfile.in)
 )
 # --cluster: also what the sweep tests of ctest label `cluster` need (a
 # single-node Slurm cluster, GNU parallel). Not by default: on a machine with

@@ -2,12 +2,12 @@
 //! Tutorial 5: compare estimator settings in closed loop, with a baseline
 //! beside them, the way `ofv compare` does.
 //!
-//!   tutorial-compare-settings [OUT_DIR] [--seeds N] [--duration S]
+//!     tutorial-compare-settings [OUT_DIR] [--seeds N] [--duration S]
 //!
 //! From the command line the same comparison is
 //!
-//!   ofv compare --scenarios sim/scenarios/dvd-one-hand.yaml sim/scenarios/sweep.yaml
-//!               --grid my-grid.yaml --seeds 2 --jobs 2 --out OUT_DIR
+//!     ofv compare --scenarios sim/scenarios/dvd-one-hand.yaml sim/scenarios/sweep.yaml
+//!                 --grid my-grid.yaml --seeds 2 --jobs 2 --out OUT_DIR
 //!
 //! with my-grid.yaml holding the variants below (docs/compare.md).
 #include <ofv/loop/compare.h>

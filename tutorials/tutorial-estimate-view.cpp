@@ -2,7 +2,7 @@
 //! Tutorial 1: estimate the occlusion-free view of one frame from a scene file,
 //! with the paper's settings and with the authors' code preset.
 //!
-//!   tutorial-estimate-view [SCENE.json]
+//!     tutorial-estimate-view [SCENE.json]
 //!
 //! The scene format is the one of `ofv estimate` (see README.md).
 #include <ofv/estimator.h>

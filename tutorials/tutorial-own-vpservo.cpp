@@ -6,9 +6,9 @@
 //! lies 60 degrees around the object. FeatureSphereView moves the camera along
 //! the sphere of radius 0.5 m to it, keeping the object centred.
 //!
-//!   tutorial-own-vpservo [--display]
+//!     tutorial-own-vpservo [--display]
 //!
-//! --display shows the loop live (ofv::LiveDisplay, in real time): the
+//! `--display` shows the loop live (ofv::LiveDisplay, in real time): the
 //! feature's current value (C's projection) and desired one (the image
 //! centre), the scene view, the velocity and the feature error. Left click
 //! pauses, right click or q ends the loop.

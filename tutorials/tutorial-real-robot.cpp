@@ -8,11 +8,11 @@
 //! (speed, acceleration, workspace, zero velocity when the object is lost or
 //! the frame is stale). This program is compiled everywhere; the driver part
 //! only where ViSP has the driver (Debian's libvisp-dev has none: it then says
-//! so and exits, or with --dry-run prints the commands on a simulated camera).
+//! so and exits, or with `--dry-run` prints the commands on a simulated camera).
 //!
-//!   tutorial-real-robot [--dry-run] [--display]
+//!     tutorial-real-robot [--dry-run] [--display]
 //!
-//! --display shows the loop live (ofv::LiveDisplay): the problem's
+//! `--display` shows the loop live (ofv::LiveDisplay): the problem's
 //! supervoxels and occluders as the camera sees them, the feature, the scene
 //! view and the curves. A left click pauses (the robot is sent a zero
 //! velocity first), a right click or q stops as Ctrl-C does.

@@ -2,9 +2,9 @@
 //! Tutorial 2: servo a simulated free-flying camera around a hand that enters
 //! between it and the object, with ofv's occlusion-free view as the target.
 //!
-//!   tutorial-servo-free-camera [SCENARIO] [--robot NAME] [--display]
+//!     tutorial-servo-free-camera [SCENARIO] [--robot NAME] [--display]
 //!
-//! --display shows the loop live in ViSP windows (ofv::LiveDisplay), paced at
+//! `--display` shows the loop live in ViSP windows (ofv::LiveDisplay), paced at
 //! the scenario's rate: left click pauses, right click or q ends the episode.
 //! The loop is the one of `ofv simulate`: render the RGB-D frame at the
 //! camera's pose, take the ground-truth supervoxels (perception errors aside),

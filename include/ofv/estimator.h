@@ -72,10 +72,10 @@ enum class InitialViewUsed { SphericalMean, VectorMean, Camera };
 struct EstimatorSettings {
   double r_seed = 0.02;    ///< supervoxel seed resolution R_seed [m]
   double r_sphere = 0.5;   ///< radius of the solution sphere R_sphere [m]
-  InitialView initial_view = InitialView::SphericalMean;
+  InitialView initial_view = InitialView::SphericalMean;  ///< how t0 averages the normal rays
   double clearance = 0.02;     ///< stop when no projected point is closer than this to t_i [m]
   double push_radius = 0.5;    ///< projected points closer than this push the iterate [m]
-  PushWeighting push_weighting = PushWeighting::Sum;
+  PushWeighting push_weighting = PushWeighting::Sum;  ///< how the projected points push the iterate
   double step = 0.02;          ///< length of one push on the tangent plane [m]
   int max_iterations = 500;    ///< push steps before giving up (>= 0)
   bool warm_start = false;     ///< start from the previous frame's view instead of t0
@@ -103,17 +103,17 @@ inline constexpr int kMaxIterations = 100000000;
  * explicit values, then validates (spec §4 `preset`, §7).
  */
 struct EstimatorParams {
-  Preset preset = Preset::Paper;
-  std::optional<double> r_seed;
-  std::optional<double> r_sphere;
-  std::optional<InitialView> initial_view;
-  std::optional<double> clearance;
-  std::optional<double> push_radius;
-  std::optional<PushWeighting> push_weighting;
-  std::optional<double> step;
-  std::optional<int> max_iterations;
-  std::optional<bool> warm_start;
-  std::optional<double> time_budget;
+  Preset preset = Preset::Paper;  ///< the named set of settings the unset fields take
+  std::optional<double> r_seed;    ///< R_seed [m]; unset: EstimatorSettings' default
+  std::optional<double> r_sphere;  ///< R_sphere [m]; unset: EstimatorSettings' default
+  std::optional<InitialView> initial_view;      ///< unset: EstimatorSettings' default
+  std::optional<double> clearance;              ///< [m]; unset: the preset's (from r_seed)
+  std::optional<double> push_radius;            ///< [m]; unset: the preset's (r_sphere)
+  std::optional<PushWeighting> push_weighting;  ///< unset: EstimatorSettings' default
+  std::optional<double> step;                   ///< [m]; unset: the preset's (from r_seed)
+  std::optional<int> max_iterations;            ///< unset: the preset's (500 or 50)
+  std::optional<bool> warm_start;               ///< unset: EstimatorSettings' default (false)
+  std::optional<double> time_budget;            ///< [s]; unset: EstimatorSettings' default
 
   /// \brief The settings these parameters stand for.
   /// \throws std::invalid_argument naming the parameter and value that break spec §7.
@@ -146,22 +146,22 @@ struct ViewProblem {
 
 /// \brief Mean and population standard deviation of an angular error [deg].
 struct AngularErrorStats {
-  double mean = 0.0;
-  double std = 0.0;
+  double mean = 0.0;  ///< mean [deg]
+  double std = 0.0;   ///< population standard deviation [deg]
 };
 
 /// \brief The estimator's result for one frame (spec §8), world frame [m].
 struct ViewEstimate {
   Eigen::Vector3d t0 = Eigen::Vector3d::Zero();  ///< initial (occlusion-blind) view
   Eigen::Vector3d tf = Eigen::Vector3d::Zero();  ///< final (occlusion-free) view
-  ViewStatus status = ViewStatus::NoOccluders;
+  ViewStatus status = ViewStatus::NoOccluders;  ///< how the iteration ended
   int iterations = 0;  ///< push steps taken (0 when the start is clear)
-  InitialViewUsed initial_view_used = InitialViewUsed::SphericalMean;
+  InitialViewUsed initial_view_used = InitialViewUsed::SphericalMean;  ///< the rule that gave t0
   int skipped_supervoxels = 0;  ///< non-finite, zero normal, or at/outside the sphere
   int skipped_occluders = 0;    ///< non-finite
   /// Angular error (eq. 9) of t0 and tf over the used rays; empty when no supervoxel is left.
   std::optional<AngularErrorStats> error_t0;
-  std::optional<AngularErrorStats> error_tf;
+  std::optional<AngularErrorStats> error_tf;  ///< the same for t_f
 
   // Diagnostics.
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< C used
@@ -244,14 +244,20 @@ struct UsableInput {
 
 /// \name Enumeration words as used in scene files and on the command line.
 /// \{
-[[nodiscard]] const char* to_string(InitialView v);
+[[nodiscard]] const char* to_string(InitialView v);  ///< `spherical_mean` or `vector_mean`
+/// `sum` or `inverse_distance`.
 [[nodiscard]] const char* to_string(PushWeighting v);
+/// `paper` or `authors_code`.
 [[nodiscard]] const char* to_string(Preset v);
+/// `converged`, `not_converged`, `out_of_time`, `no_occluders` or `no_supervoxels`.
 [[nodiscard]] const char* to_string(ViewStatus v);
+/// `spherical_mean`, `vector_mean` or `camera`.
 [[nodiscard]] const char* to_string(InitialViewUsed v);
 /// Parse a word; std::nullopt if it is not one of the listed words.
 [[nodiscard]] std::optional<InitialView> parse_initial_view(const std::string& word);
+/// The PushWeighting of `sum` or `inverse_distance`; std::nullopt for any other word.
 [[nodiscard]] std::optional<PushWeighting> parse_push_weighting(const std::string& word);
+/// The Preset of `paper` or `authors_code`; std::nullopt for any other word.
 [[nodiscard]] std::optional<Preset> parse_preset(const std::string& word);
 /// \}
 

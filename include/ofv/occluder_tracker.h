@@ -124,8 +124,11 @@ class OccluderTracker {
   /// \brief A frame without an object: the tracks coast (no clusters) by dt.
   const std::vector<OccluderTrack>& coast(double dt);
 
+  /// \brief Every track, confirmed or not, in id order (as the last update() returned).
   [[nodiscard]] const std::vector<OccluderTrack>& tracks() const { return tracks_; }
+  /// \brief The settings it was constructed with.
   [[nodiscard]] const TrackerSettings& settings() const { return settings_; }
+  /// \brief Forgets every track: the next update() is a first frame, ids start at 0 again.
   void reset();
 
  private:
@@ -141,6 +144,7 @@ class OccluderTracker {
  * \brief Where the occluders will be: the points of every confirmed track
  *        seen this frame and moving faster than `min_speed`, each shifted by
  *        velocity x tau for every tau of `times`.
+ * \param tracks    the tracker's tracks (OccluderTracker::tracks()).
  * \param times     future times [s] (> 0).
  * \param min_speed slower tracks are taken as still [m/s].
  * \return 3 x K points (K = 0 when nothing moves).

@@ -108,11 +108,13 @@ class SettingsTable {
     return out;
   }
 
+  /// \brief One setting: its documentation and how to write and read it.
   struct Row {
-    SettingDoc doc;
-    Setter set;
-    Getter get;
+    SettingDoc doc;  ///< name, type, default, unit, meaning
+    Setter set;      ///< parses a value and writes it into a T
+    Getter get;      ///< reads it from a T as text
   };
+  /// \brief Every row, in table order.
   [[nodiscard]] const std::vector<Row>& rows() const { return rows_; }
 
  private:

@@ -56,8 +56,11 @@ struct ScoredView {
  *        (spec §1, §7) it sees past the occluders, each occluder a ball of
  *        radius `occluder_radius`, and its mean angular error (eq. 9).
  *        Supervoxels facing away (normal . (view - v) <= 0) count as unseen.
+ * \param problem  the frame's supervoxels and occluders (world frame).
  * \param centroid C of the problem (ViewEstimate::centroid) [m].
  * \param r_sphere radius of the sphere [m].
+ * \param view     the camera position to score (world frame) [m].
+ * \param occluder_radius radius of each occluder point's ball [m].
  */
 [[nodiscard]] ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                                     double r_sphere, const Eigen::Vector3d& view,
@@ -90,7 +93,7 @@ enum class NoFreeView {
 
 /// \brief Settings of most_visible_view().
 struct NoFreeViewSettings {
-  NoFreeView mode = NoFreeView::MostVisible;
+  NoFreeView mode = NoFreeView::MostVisible;  ///< what the loop does without a free view
   double step_deg = 8.0;          ///< neighbours of the current view, this far from it seen from C [deg]
   double margin = 0.05;           ///< a view must see this much more of the object than the current one
   double occluder_radius = 0.02;  ///< an occluder point blocks lines of sight passing closer than this [m]
@@ -145,7 +148,12 @@ struct NoFreeViewSettings {
  *        one sees at least `margin` more. Climbing this way the camera
  *        moves only towards clearly better views and otherwise holds still,
  *        never towards a gap that only an edge of the object shows through.
+ * \param problem  the frame's supervoxels and occluders (world frame).
+ * \param centroid C of the problem [m].
+ * \param r_sphere radius of the sphere [m].
  * \param current the camera's position (projected on the sphere) [m].
+ * \param others  further candidate positions (projected on the sphere) [m].
+ * \param settings `step_deg`, `margin` and `occluder_radius` are used.
  */
 [[nodiscard]] ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                                            double r_sphere, const Eigen::Vector3d& current,

@@ -21,8 +21,8 @@ namespace ofv {
 
 /// \brief One frame as stored in a scene file: the problem and the parameters.
 struct Scene {
-  ViewProblem problem;
-  EstimatorParams params;
+  ViewProblem problem;     ///< the supervoxels, occluders and optional inputs [m]
+  EstimatorParams params;  ///< the file's `params`: a preset and explicit values
 };
 
 /// \brief Parses a scene from JSON; `source` names it in error messages.

@@ -25,7 +25,7 @@ struct CropVolume {
   Eigen::AlignedBox3d box;
   /// Keep points within `radius` of `centre` (world frame, [m]); radius <= 0: no sphere test.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  double radius = 0.0;
+  double radius = 0.0;     ///< radius of the sphere test [m]; <= 0: no sphere test
   double max_depth = 3.0;  ///< drop points farther than this along the optical axis [m]
 };
 
@@ -48,6 +48,7 @@ struct WorldCloud {
   std::size_t valid_pixels = 0;          ///< pixels with finite, positive depth (after stride)
   std::size_t cropped_points = 0;        ///< of those, inside the crop volume
 
+  /// \brief Empties it for the next frame (the vectors keep their capacity).
   void clear() {
     points.clear();
     colours.clear();
@@ -65,12 +66,14 @@ struct WorldCloud {
  */
 class CloudBuilder {
  public:
+  /// \throws std::invalid_argument if `pixel_stride` < 1.
   explicit CloudBuilder(const CloudSettings& settings = {});
 
   /// \brief Fills `out` from `frame` cropped to `crop`.
   /// \throws std::invalid_argument if the frame's image sizes disagree with its intrinsics.
   void build(const RgbdFrame& frame, const CropVolume& crop, WorldCloud& out);
 
+  /// \brief The settings it was constructed with.
   [[nodiscard]] const CloudSettings& settings() const { return settings_; }
 
  private:

@@ -55,6 +55,14 @@ struct PerceiveSummary {
   /// Means over the scored frames of each score that is defined there
   /// (PerceptionScores; hidden_error needs the object's surface, which a recording lacks).
   std::optional<double> object_precision, object_recall, occluder_precision, occluder_recall, centroid_error;
+  /// \var object_recall
+  /// \brief Mean of PerceptionScores::object_recall over the scored frames that define it.
+  /// \var occluder_precision
+  /// \brief Mean of PerceptionScores::occluder_precision over the scored frames that define it.
+  /// \var occluder_recall
+  /// \brief Mean of PerceptionScores::occluder_recall over the scored frames that define it.
+  /// \var centroid_error
+  /// \brief Mean of PerceptionScores::centroid_error over the scored frames that define it [m].
 };
 
 /**
@@ -66,7 +74,11 @@ struct PerceiveSummary {
  * `observer` is called once per frame, in order, before the next frame is
  * read; the frame it gets lives only for the call.
  *
+ * \param source     the frames, read until its end.
+ * \param ps         the front end's settings.
+ * \param settings   the estimator's settings.
  * \param max_frames stop after this many frames; negative: no limit.
+ * \param observer   called with every frame once it is perceived (may be empty).
  * \throws std::invalid_argument for invalid settings or a frame whose buffers
  *         disagree with its intrinsics; whatever `source` and `observer` throw
  *         (std::runtime_error when a device or file fails mid-way).

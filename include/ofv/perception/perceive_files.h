@@ -23,6 +23,7 @@ namespace ofv {
 
 /**
  * \brief The frame's record as JSON text.
+ * \param frame  the frame as perceive() gave it to its observer.
  * \param params the estimator parameters given by the user (written into `problem`).
  * \param indent as nlohmann::json::dump: -1 one line (no newline), >= 0 that
  *        many spaces per level.

@@ -106,6 +106,7 @@ struct TrackingSettings {
 
 /// \brief How the object is picked in the first frame.
 struct ObjectSelection {
+  /// \brief Which of the fields below points out the object.
   enum class Mode {
     /// After removing the dominant plane (RANSAC), the cluster of adjacent,
     /// colour-consistent supervoxels (chromaticities within
@@ -114,7 +115,7 @@ struct ObjectSelection {
     Box,    ///< supervoxels whose centroid is inside `box` (world frame)
     Image,  ///< supervoxels whose centroid projects inside `rect` or onto a non-zero `mask` pixel
   };
-  Mode mode = Mode::Auto;
+  Mode mode = Mode::Auto;  ///< how the object is found
   Eigen::AlignedBox3d box;         ///< world frame [m], for Mode::Box (also the first crop)
   Eigen::AlignedBox2i rect;        ///< pixels [u0, v0] .. [u1, v1] inclusive, for Mode::Image
   std::vector<std::uint8_t> mask;  ///< width x height, non-zero = object; overrides `rect`
@@ -123,8 +124,8 @@ struct ObjectSelection {
 /// \brief All settings of the front end.
 struct PerceptionSettings {
   CloudSettings cloud;  ///< back-projection; its voxel resolution is supervoxels.voxel_resolution
-  SupervoxelSettings supervoxels;
-  TrackingSettings tracking;
+  SupervoxelSettings supervoxels;  ///< the supervoxel stage
+  TrackingSettings tracking;        ///< selection in the first frame, tracking from frame to frame
   double r_sphere = EstimatorSettings{}.r_sphere;  ///< R_sphere = d_pref (paper eq. 2) [m]
   double crop_margin = 0.1;  ///< crop radius = r_sphere + crop_margin around the previous C [m]
   double max_depth = 3.0;    ///< points farther along the optical axis are dropped [m]
@@ -181,8 +182,8 @@ struct PerceptionSettings {
     /// would give: the limit of any front end from this sensor.
     Labels,
   };
-  Classes classes = Classes::Segmentation;
-  ObjectSelection selection;
+  Classes classes = Classes::Segmentation;  ///< where the classes come from
+  ObjectSelection selection;  ///< how the object is found in the first frame
 };
 
 /// \brief Whether the object was found in a frame.
@@ -200,16 +201,16 @@ struct SupervoxelInfo {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< v_n [m]
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< unit, towards the camera that saw it
   Eigen::Vector3f colour = Eigen::Vector3f::Zero();    ///< mean R, G, B in [0, 255]
-  int voxel_count = 0;
+  int voxel_count = 0;       ///< occupied voxels it holds
   bool normal_valid = true;  ///< false when PCL gave no finite normal (not used as object vertex)
-  SupervoxelClass label = SupervoxelClass::Background;
+  SupervoxelClass label = SupervoxelClass::Background;  ///< its class in this frame
 };
 
 /// \brief An oriented box: centre, axes (columns, right-handed) and half extents [m].
 struct OrientedBox {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();         ///< world frame [m]
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();       ///< unit axes (columns), world frame
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< along each axis [m]
   /// True when world point p is inside (boundary included).
   [[nodiscard]] bool contains(const Eigen::Vector3d& p) const {
     const Eigen::Vector3d local = axes.transpose() * (p - centre);
@@ -222,11 +223,11 @@ struct PerceptionCounts {
   std::size_t valid_pixels = 0;    ///< pixels with depth (after the stride)
   std::size_t cropped_points = 0;  ///< inside the working volume
   std::size_t voxels = 0;          ///< occupied voxels given to the supervoxel stage
-  std::size_t supervoxels = 0;
+  std::size_t supervoxels = 0;      ///< supervoxels of the frame
   std::size_t adjacency_edges = 0;  ///< pairs within R_adj
-  std::size_t object = 0;
-  std::size_t interacting = 0;
-  std::size_t occluders = 0;
+  std::size_t object = 0;       ///< object supervoxels
+  std::size_t interacting = 0;  ///< interacting supervoxels (in contact with the object, in its augmented OBB)
+  std::size_t occluders = 0;    ///< occluder supervoxels (inside the sphere, outside the box)
   std::size_t beyond_view = 0;  ///< occluder points added beyond the image border (PerceptionSettings::beyond_view)
   std::size_t object_voxels = 0;  ///< seen in this frame
   std::size_t hidden_voxels = 0;  ///< remembered behind occluders, added to the object cloud
@@ -241,12 +242,12 @@ struct PerceptionTimings {
   double adjacency = 0.0;    ///< R_adj graph
   double tracking = 0.0;     ///< selection or frame-to-frame tracking
   double classify = 0.0;     ///< PCA, OBB, interacting/occluders, ViewProblem
-  double total = 0.0;
+  double total = 0.0;        ///< the whole frame
 };
 
 /// \brief Everything the front end found in one frame (world frame [m]).
 struct PerceptionResult {
-  TrackingStatus status = TrackingStatus::Lost;
+  TrackingStatus status = TrackingStatus::Lost;  ///< whether the object was found
   /// The estimator's input: object supervoxels and normals, occluders,
   /// centroid C, PCA axes, camera position. Empty when status is Lost.
   ViewProblem problem;
@@ -262,8 +263,8 @@ struct PerceptionResult {
   /// The remembered object voxels this frame does not show (behind
   /// something, out of the image, presumed behind an occluder) [m].
   std::vector<Eigen::Vector3f> hidden;
-  PerceptionCounts counts;
-  PerceptionTimings timings;
+  PerceptionCounts counts;    ///< what each stage found
+  PerceptionTimings timings;  ///< what each stage took
   std::string message;  ///< why the object is lost, when it is
 };
 
@@ -272,11 +273,14 @@ struct PerceptionResult {
  *        lost) with the occluders seen in the frame, the ones beyond the
  *        image border as presumed, and the object's voxels seen in the frame
  *        times a voxel's face as the shown area [m²]. Its age is left 0.
+ * \param result the front end's result for the frame
  * \param voxel the front end's voxel edge (SupervoxelSettings::voxel_resolution) [m]
  */
 [[nodiscard]] Observation observation(const PerceptionResult& result, double voxel);
 
+/// \brief The status's word in files and on the terminal: initialised, tracking, lost.
 [[nodiscard]] const char* to_string(TrackingStatus status);
+/// \brief The class's word: object, interacting, occluder, background.
 [[nodiscard]] const char* to_string(SupervoxelClass label);
 /// \brief The word of PerceptionSettings::Classes: segmentation, labels.
 [[nodiscard]] const char* to_string(PerceptionSettings::Classes classes);
@@ -304,8 +308,8 @@ class Perception {
   /// \throws std::invalid_argument for invalid settings (see validate()).
   explicit Perception(const PerceptionSettings& settings);
   ~Perception();
-  Perception(Perception&&) noexcept;
-  Perception& operator=(Perception&&) noexcept;
+  Perception(Perception&&) noexcept;             ///< moves the front end and what it remembers
+  Perception& operator=(Perception&&) noexcept;  ///< moves the front end and what it remembers
   Perception(const Perception&) = delete;
   Perception& operator=(const Perception&) = delete;
 
@@ -316,6 +320,7 @@ class Perception {
   /// \brief Forgets the object: the next frame starts again from the selection.
   void reset();
 
+  /// \brief The settings it was made with.
   [[nodiscard]] const PerceptionSettings& settings() const;
 
  private:
@@ -335,6 +340,7 @@ class PerceptionObserver final : public Observer {
   [[nodiscard]] Observation observe(const RgbdFrame& frame) override;
   /// \brief The front end's result of the last observe() (empty before the first).
   [[nodiscard]] const PerceptionResult& last() const { return last_; }
+  /// \brief The front end's settings.
   [[nodiscard]] const PerceptionSettings& settings() const { return perception_.settings(); }
 
  private:

@@ -65,6 +65,8 @@ class VoxelLabels {
     std::uint16_t label = kPixelNone;                ///< the label most of them show
   };
 
+  /// \brief The voxel grid of `frame`'s labelled pixels.
+  /// \param frame  a frame with labels
   /// \param voxel  edge of the cells [m] (> 0)
   /// \param stride every stride-th pixel in u and v (>= 1), as CloudSettings::pixel_stride
   /// \param max_depth pixels farther along the optical axis are left out [m]
@@ -78,6 +80,7 @@ class VoxelLabels {
   /// \brief The label of find(p); kPixelNone when there is no cell.
   [[nodiscard]] std::uint16_t label_at(const Eigen::Vector3f& p) const;
 
+  /// \brief The occupied cells, indexed as find() returns them.
   [[nodiscard]] const std::vector<Cell>& cells() const { return cells_; }
 
  private:
@@ -99,9 +102,15 @@ struct PerceptionTruth {
 
 /// \brief One frame's perception scores (see the file's description).
 struct PerceptionScores {
+  /// Of the voxels called object, the fraction whose cell is object.
   std::optional<double> object_precision;
+  /// Of the object cells the frame shows, the fraction found as object.
   std::optional<double> object_recall;
+  /// Of the voxels called occluder (the support's left out), the fraction
+  /// whose cell is an occluding body.
   std::optional<double> occluder_precision;
+  /// Of the occluding bodies' cells within r_sphere of the true centroid,
+  /// the fraction found as occluder.
   std::optional<double> occluder_recall;
   std::optional<double> centroid_error;  ///< [m]
   std::optional<double> hidden_error;    ///< mean over the hidden voxels [m]
@@ -112,6 +121,9 @@ struct PerceptionScores {
 
 /**
  * \brief Scores the front end's result on a labelled frame.
+ * \param frame    the frame the front end processed, with its labels.
+ * \param result   what Perception::process() returned for it.
+ * \param truth    the true centroid and surface, where known.
  * \param settings the front end's (voxel resolution, pixel stride, max depth).
  * \throws std::invalid_argument when the frame has no labels.
  */
@@ -123,6 +135,7 @@ struct PerceptionScores {
  *        Observation::shown_area: its voxels (the cells most of whose pixels
  *        show the object) times a voxel's face. What a front end that
  *        classified every pixel right would report.
+ * \param frame    a frame with labels
  * \param settings the front end's (voxel resolution, pixel stride, max depth).
  * \throws std::invalid_argument when the frame has no labels.
  */

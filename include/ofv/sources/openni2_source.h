@@ -121,6 +121,7 @@ class OniWriter {
   void write(const RgbdFrame& frame);
   /// Patches the frame counts and ends the file. Idempotent.
   void close();
+  /// \brief Frames written so far.
   [[nodiscard]] int count() const { return count_; }
 
  private:

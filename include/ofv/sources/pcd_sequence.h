@@ -56,6 +56,7 @@ class PcdSequenceSource : public FrameSource {
   /// malformed, it cannot be read, is not organised, or its intrinsics cannot be fitted.
   std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::string describe() const override;
+  /// \brief Frames in the sequence (its PCD files).
   [[nodiscard]] std::size_t size() const { return files_.size(); }
 
  private:
@@ -74,6 +75,7 @@ class PcdSequenceWriter {
   /// \throws std::invalid_argument for inconsistent buffers; std::runtime_error when a file cannot
   /// be written.
   void write(const RgbdFrame& frame);
+  /// \brief Frames written so far.
   [[nodiscard]] std::size_t count() const { return count_; }
 
  private:

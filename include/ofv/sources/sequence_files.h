@@ -34,7 +34,7 @@ void for_each_data_line(std::istream& in, const std::function<void(const std::st
 /// \brief A timestamped camera pose wMc (camera -> world), ViSP camera axes.
 struct StampedPose {
   double time = 0.0;  ///< [s]
-  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< camera pose in the world [m]
 };
 
 /// \brief Largest difference from 1 of a pose file's quaternion norm (files

@@ -57,8 +57,11 @@ class DisplayUnavailable : public std::runtime_error {
  */
 class DisplayControl {
  public:
+  /// \param pausable false: the pause events change nothing (a run a pause could not hold).
   explicit DisplayControl(bool pausable = true) : pausable_(pausable) {}
+  /// \brief Where the run is: going, paused by the user, or ended by the user (final).
   enum class State { Running, Paused, Quit };
+  /// \brief What the user did in a window.
   enum class Event {
     LeftClick,
     MiddleClick,
@@ -68,6 +71,7 @@ class DisplayControl {
   };
   /// \brief Applies an event; returns the new state.
   State handle(Event event);
+  /// \brief The current state (Running at first).
   [[nodiscard]] State state() const { return state_; }
   /// \brief The event a key name (as vpDisplay::getKeyboardEvent gives it) stands for, if any.
   [[nodiscard]] static std::optional<Event> key_event(const std::string& key);
@@ -143,7 +147,9 @@ class LiveDisplay {
   void set_pause_hook(std::function<void()> hook);
   /// \brief Applies an event as a click or a key would (tests, other front ends).
   DisplayControl::State handle(DisplayControl::Event event);
+  /// \brief The state of its DisplayControl: running, paused or quit.
   [[nodiscard]] DisplayControl::State state() const;
+  /// \brief True once the user asked to end the run (right click, q or Escape).
   [[nodiscard]] bool quit_requested() const { return state() == DisplayControl::State::Quit; }
 
   /// \brief The camera window's pixels as shown (vpDisplay::getImage).

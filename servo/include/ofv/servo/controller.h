@@ -21,11 +21,12 @@ namespace ofv {
 
 /// \brief Settings of ViewController. Speeds in the camera frame.
 struct ControllerSettings {
+  /// \brief The velocity law.
   enum class Law {
     Pbvs,    ///< vpFeatureTranslation(cdMc) + vpFeatureThetaU(cdRc): straight line to the target pose
     Sphere,  ///< FeatureSphereView: along the sphere, object centred
   };
-  Law law = Law::Sphere;
+  Law law = Law::Sphere;  ///< the velocity law (setting `controller`)
   /// lambda [1/s]: the error decays as exp(-gain t) until the speed limits bind.
   /// 4 recovers from a hand entering the view in well under a second at 30 Hz.
   double gain = 4.0;
@@ -48,6 +49,7 @@ void validate(const ControllerSettings& settings);
  */
 class ViewController {
  public:
+  /// \throws std::invalid_argument naming the field and value when a setting is out of range.
   explicit ViewController(const ControllerSettings& settings = {});
 
   /**
@@ -63,6 +65,7 @@ class ViewController {
 
   /// \brief Forgets the filtered target (a new episode, a re-acquired object).
   void reset() { filtered_.reset(); }
+  /// \brief The settings it was constructed with.
   [[nodiscard]] const ControllerSettings& settings() const { return settings_; }
   /// \brief The error norm of the last update (feature or pose error).
   [[nodiscard]] double last_error() const { return last_error_; }

@@ -26,11 +26,14 @@
  * not depend on the camera's orientation), the interaction matrix
  * \f$ \dot{\mathbf{s}} = \mathbf{L}_s \mathbf{v} \f$ is
  * \f[ \mathbf{L}_s = \begin{bmatrix}
- *   -1/c_z & 0 & x/c_z & xy & -(1+x^2) & y \\
- *   0 & -1/c_z & y/c_z & 1+y^2 & -xy & -x \\
- *   \multicolumn{3}{c}{\mathbf{d}^\top} & 0 & 0 & 0 \\
- *   \multicolumn{3}{c}{-{}^w\mathbf{R}_c \mathbf{P} / \rho} & \multicolumn{3}{c}{\mathbf{0}}
- * \end{bmatrix}. \f]
+ *   \mathbf{L}_{xy,\upsilon} & \mathbf{L}_{xy,\omega} \\
+ *   \mathbf{d}^\top & \mathbf{0}_{1\times3} \\
+ *   -{}^w\mathbf{R}_c \mathbf{P} / \rho & \mathbf{0}_{3\times3}
+ * \end{bmatrix},\quad
+ * \mathbf{L}_{xy,\upsilon} = \begin{bmatrix} -1/c_z & 0 & x/c_z \\
+ *   0 & -1/c_z & y/c_z \end{bmatrix},\quad
+ * \mathbf{L}_{xy,\omega} = \begin{bmatrix} xy & -(1+x^2) & y \\
+ *   1+y^2 & -xy & -x \end{bmatrix}. \f]
  * The translation it asks for is tangent to the sphere (through P) plus a
  * radial term that holds ρ at R, so the camera travels along the sphere, not
  * along the chord through the occluders; the rotation only centres C. L has
@@ -59,6 +62,7 @@ namespace ofv {
 /// \brief The sphere-view feature (see the file documentation for L_s).
 class FeatureSphereView : public vpBasicFeature {
  public:
+  /// \brief A feature of dimension 6 with s = 0; build() sets its state.
   FeatureSphereView();
 
   /**
@@ -74,17 +78,23 @@ class FeatureSphereView : public vpBasicFeature {
 
   /// Selectors of the components, for interaction() and error().
   static unsigned int selectX();
-  static unsigned int selectY();
-  static unsigned int selectRho();
+  static unsigned int selectY();    ///< y = c_y / c_z, the vertical image coordinate of C
+  static unsigned int selectRho();  ///< rho - R, the distance from C off the sphere
   static unsigned int selectTangent();  ///< the three components of e
 
+  /// \brief Resets it to dimension 6, s = 0, not built (vpBasicFeature's contract).
   void init() override;
+  /// \brief The rows of L_s (file documentation) that `select` picks.
+  /// \throws std::logic_error when build() was not called.
   vpMatrix interaction(unsigned int select = FEATURE_ALL) override;
+  /// \brief Prints the selected components of s (x, y, rho-R, f_x, f_y, f_z) to std::cout.
   void print(unsigned int select = FEATURE_ALL) const override;
+  /// \brief A copy allocated with new (vpServo owns it).
   FeatureSphereView* duplicate() const override;
   /// Draws the projection of C (the centring part of the feature).
   void display(const vpCameraParameters& cam, const vpImage<unsigned char>& I,
                const vpColor& color = vpColor::green, unsigned int thickness = 1) const override;
+  /// Draws the projection of C on a colour image.
   void display(const vpCameraParameters& cam, const vpImage<vpRGBa>& I,
                const vpColor& color = vpColor::green, unsigned int thickness = 1) const override;
 

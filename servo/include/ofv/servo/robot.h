@@ -57,6 +57,7 @@ class CameraRobot {
   [[nodiscard]] virtual vpHomogeneousMatrix wMc() const = 0;
   /// \brief Applies the camera twist v (camera frame, [m/s, rad/s]) for dt seconds.
   virtual RobotStep step(const vpColVector& v, double dt) = 0;
+  /// \brief The robot's name in messages and records (`camera`, `viper850`, ...).
   [[nodiscard]] virtual std::string name() const = 0;
 };
 
@@ -64,6 +65,7 @@ class CameraRobot {
 ///        limit of its own (the controller and the safety filter bound it).
 class FreeFlyingCamera : public CameraRobot {
  public:
+  /// \param wMc the camera's start pose.
   explicit FreeFlyingCamera(const vpHomogeneousMatrix& wMc);
   [[nodiscard]] vpHomogeneousMatrix wMc() const override { return camera_.getPosition(); }
   RobotStep step(const vpColVector& v, double dt) override;
@@ -76,7 +78,10 @@ class FreeFlyingCamera : public CameraRobot {
 /// \brief A ViSP arm model (vpViper850 or vpAfma6) stepped on its kinematics.
 class KinematicArm : public CameraRobot {
  public:
+  /// \brief Which of ViSP's arm models.
   enum class Model { Viper850, Afma6 };
+  /// \brief The arm in start_joints(model).
+  /// \param model     the arm.
   /// \param wMc_start camera start pose; the base is placed to match it.
   KinematicArm(Model model, const vpHomogeneousMatrix& wMc_start);
   /// \brief The start configuration: away from singularities and joint limits, camera forward.
@@ -85,8 +90,11 @@ class KinematicArm : public CameraRobot {
   [[nodiscard]] vpHomogeneousMatrix wMc() const override;
   RobotStep step(const vpColVector& v, double dt) override;
   [[nodiscard]] std::string name() const override;
+  /// \brief The joint positions [rad or m].
   [[nodiscard]] const vpColVector& joints() const { return q_; }
+  /// \brief The model's lower joint limits [rad or m].
   [[nodiscard]] vpColVector joint_min() const;
+  /// \brief The model's upper joint limits [rad or m].
   [[nodiscard]] vpColVector joint_max() const;
   /// \brief Sets the joints (clamped to the limits); for tests and start poses.
   void set_joints(const vpColVector& q);
@@ -115,6 +123,9 @@ class VispRobot : public CameraRobot {
   /// \brief Sends a camera twist to the robot (ThreadedArm slows it near joint limits).
   using Command = std::function<void(const vpColVector& v)>;
   /// \brief `Driver`: any vpRobot with getPosition(vpRobot::REFERENCE_FRAME, vpPoseVector&).
+  /// \param robot   the driver; it must outlive this object. Set to velocity control.
+  /// \param fMw     the world frame in the robot's reference frame.
+  /// \param name    the robot's name().
   /// \param command sends the twist; empty: setVelocity(CAMERA_FRAME, v).
   template <class Driver>
   VispRobot(Driver& robot, const vpHomogeneousMatrix& fMw, std::string name, Command command = {})
@@ -124,6 +135,7 @@ class VispRobot : public CameraRobot {
                     return vpHomogeneousMatrix(p);
                   }),
                   fMw, std::move(name), std::move(command)) {}
+  /// \brief As the template constructor, with the camera pose read by `fMc`.
   VispRobot(vpRobot& robot, PoseReader fMc, const vpHomogeneousMatrix& fMw, std::string name, Command command = {});
   [[nodiscard]] vpHomogeneousMatrix wMc() const override;
   RobotStep step(const vpColVector& v, double dt) override;
@@ -163,8 +175,8 @@ class ThreadedArm : public CameraRobot {
   [[nodiscard]] std::string name() const override;
   /// \brief The simulator's joints now, and its limits (its own, narrower than KinematicArm's on the Viper850).
   [[nodiscard]] vpColVector joints() const;
-  [[nodiscard]] vpColVector joint_min() const;
-  [[nodiscard]] vpColVector joint_max() const;
+  [[nodiscard]] vpColVector joint_min() const;  ///< the simulator's lower joint limits [rad or m]
+  [[nodiscard]] vpColVector joint_max() const;  ///< the simulator's upper joint limits [rad or m]
   /// \brief How close [rad or m] a joint may come to its limit.
   static constexpr double kJointLimitMargin = 0.02;
 

@@ -40,10 +40,10 @@ struct RobotLoopOptions {
 
 /// \brief One frame of run_on_robot(), for printing and recording.
 struct RobotLoopFrame {
-  long index = 0;
-  const RgbdFrame* frame = nullptr;
+  long index = 0;                    ///< frames before this one in the run
+  const RgbdFrame* frame = nullptr;  ///< the frame as read (its pose the robot's with pose_from_robot)
   const Observation* observation = nullptr;  ///< what the loop was given (its age set)
-  const LoopStep* step = nullptr;
+  const LoopStep* step = nullptr;  ///< what the loop decided and sent
   double dt = 0.0;         ///< period the command is applied for [s] (0 with a timestamp that does not increase)
   double frame_age = 0.0;  ///< [s]
   double source_s = 0.0;      ///< time spent waiting for and reading the frame [s]
@@ -52,7 +52,7 @@ struct RobotLoopFrame {
 
 /// \brief How a run ended.
 struct RobotLoopSummary {
-  long frames = 0;
+  long frames = 0;       ///< frames read and answered with a command
   long lost = 0;         ///< frames without the object
   bool stopped = false;  ///< ended by the stop flag
 };
@@ -66,8 +66,12 @@ struct RobotLoopSummary {
  * or is not finite, or a lost object gives a zero velocity for that frame;
  * the robot is never sent a period that is not finite and >= 0 (0 with
  * such a stop), and a non-finite timestamp is not the next frame's time base.
+ * \param source   the frames, read until it ends
  * \param observer makes each frame's observation (ofv::PerceptionObserver on
  *                 a sensor; in a rehearsal, the simulator's cut-down truth).
+ * \param robot    what carries the camera; sent each command
+ * \param settings the loop's settings (ofv::ViewLoop)
+ * \param options  how the source and the robot are treated
  * \param on_frame sees every frame after its command is sent; may be empty.
  * \throws std::invalid_argument for invalid settings; whatever the source,
  *         observer or robot throw at run time.

@@ -56,6 +56,7 @@ class SafetyFilter {
   [[nodiscard]] SafetyAction last_action() const { return action_; }
   /// \brief Forgets the previous command (the robot is at rest).
   void reset() { previous_ = vpColVector(6, 0.0); }
+  /// \brief The limits it was constructed with.
   [[nodiscard]] const SafetySettings& settings() const { return settings_; }
 
  private:

@@ -11,6 +11,7 @@ namespace ofv {
 
 /// \brief ViSP <-> Eigen for poses (same convention: aMb maps b to a).
 [[nodiscard]] vpHomogeneousMatrix to_visp(const Eigen::Isometry3d& aMb);
+/// \brief Eigen <-> ViSP for poses, the inverse of to_visp().
 [[nodiscard]] Eigen::Isometry3d to_eigen(const vpHomogeneousMatrix& aMb);
 
 /**

@@ -65,7 +65,7 @@ enum class Anticipation {
  * free view, the loop falls back to the frame's own (reactive) estimate.
  */
 struct AnticipationSettings {
-  Anticipation mode = Anticipation::Predict;
+  Anticipation mode = Anticipation::Predict;  ///< off, or predict
   double horizon = 0.8;    ///< how far ahead [s]
   int samples = 2;         ///< predicted copies over the horizon
   double min_speed = 0.15; ///< slower tracks are taken as still [m/s]
@@ -76,7 +76,7 @@ struct LoopSettings {
   EstimatorParams estimator;                  ///< the spec's settings (preset + explicit values)
   ViewMethod method = ViewMethod::Estimator;  ///< how the target view is chosen
   SamplingSettings sampling;                  ///< for ViewMethod::Sampling
-  ControllerSettings controller;
+  ControllerSettings controller;             ///< the law, gain and speed limits
   /// The last filter before the robot. Its speed limits are set together
   /// with the controller's by the table's `max_linear_speed` and
   /// `max_angular_speed`.
@@ -89,7 +89,7 @@ struct LoopSettings {
   /// view; once t0 is clear again, t0 is the target. The sampling planner
   /// keeps its previous view while it sees as much as the new best.
   bool target_hysteresis = true;
-  AnticipationSettings anticipation;
+  AnticipationSettings anticipation;  ///< how the loop looks ahead at moving occluders
   TrackerSettings tracker;           ///< the occluder tracks anticipation uses
   NoFreeViewSettings no_free_view;   ///< what to do when the estimator finds no free view
 };
@@ -105,7 +105,7 @@ struct LoopSettings {
 
 /// \brief The loop's output for one frame. World frame [m]; twists in the camera frame.
 struct LoopStep {
-  StepStatus status = StepStatus::ObjectLost;
+  StepStatus status = StepStatus::ObjectLost;  ///< what the frame came to
   std::optional<ViewEstimate> estimate;   ///< the estimator's result (none when the object is lost)
   std::optional<Eigen::Vector3d> target;  ///< the view the controller drives to (none: hold still)
   vpColVector command = vpColVector(6, 0.0);   ///< the controller's twist [m/s, rad/s]
@@ -152,6 +152,7 @@ class ViewLoop {
   /// \brief Forgets the previous view, target and command (a new run).
   void reset();
 
+  /// \brief The settings it was made with.
   [[nodiscard]] const LoopSettings& settings() const { return settings_; }
   /// \brief The resolved estimator settings (preset applied).
   [[nodiscard]] const EstimatorSettings& estimator() const { return estimator_; }

@@ -19,7 +19,7 @@ namespace ofv::sim {
 
 /// \brief An indexed triangle mesh in its body frame [m].
 struct TriangleMesh {
-  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Eigen::Vector3f> vertices;   ///< body frame [m]
   std::vector<Eigen::Vector3i> triangles;  ///< vertex indices, counter-clockwise from outside
 
   /// \brief Total surface area [m^2].
@@ -42,7 +42,9 @@ struct TriangleMesh {
 [[nodiscard]] TriangleMesh make_sheet(double size_x, double size_y, double thickness, int nx, int ny);
 /// \brief Largest mesh read_mesh() reads: vertices, triangles (PLY faces) and file size.
 constexpr std::size_t kMaxMeshVertices = 5'000'000;
+/// \brief Most triangles (PLY faces) read_mesh() reads.
 constexpr std::size_t kMaxMeshTriangles = 10'000'000;
+/// \brief Largest mesh file read_mesh() reads [bytes] (512 MiB).
 constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{512} << 20;
 
 /**

@@ -31,7 +31,7 @@ enum Label : std::uint16_t {
 
 /// \brief A rendered frame; its ground truth is `frame.labels` and `frame.object_centroid`.
 struct RenderedFrame {
-  RgbdFrame frame;
+  RgbdFrame frame;  ///< depth, colour and labels at the camera's pose, with the object's centroid
 };
 
 /// \brief Ground truth of the object at one time and camera pose.
@@ -51,6 +51,7 @@ struct ObjectTruth {
  */
 class Renderer {
  public:
+  /// \param scenario        the world to render; the renderer keeps a copy.
   /// \param surface_samples object surface samples for the ground truth.
   explicit Renderer(const Scenario& scenario, int surface_samples = 4000);
   ~Renderer();
@@ -59,6 +60,7 @@ class Renderer {
 
   /// \brief Places every body at time t [s].
   void set_time(double t);
+  /// \brief The time of the last set_time() [s]; -1 before the first.
   [[nodiscard]] double time() const { return time_; }
 
   /**
@@ -96,6 +98,7 @@ class Renderer {
   [[nodiscard]] ViewProblem ground_truth_problem(const Eigen::Isometry3d& wMc, double r_seed,
                                                  double r_sphere, double obb_margin = 0.03) const;
 
+  /// \brief The scenario it renders (its copy).
   [[nodiscard]] const Scenario& scenario() const { return scenario_; }
 
  private:

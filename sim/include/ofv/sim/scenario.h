@@ -24,8 +24,8 @@ namespace ofv::sim {
 /// \brief A timed pose: position [m] and roll-pitch-yaw [deg] (fixed axes x, y, z).
 struct Waypoint {
   double t = 0.0;  ///< [s]
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< world frame [m]
+  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();   ///< roll, pitch, yaw [deg] (rpy_deg_to_matrix())
 };
 
 /// \brief Piecewise motion through waypoints: linear in position, slerp in
@@ -44,18 +44,26 @@ enum class Role { Object, Interacting, Occluder, Background };
 
 /// \brief A rigid or deformable body of the scene.
 struct Body {
-  std::string name;
-  Role role = Role::Occluder;
+  std::string name;                  ///< label in outputs (object, holder, occluderN, table by default)
+  Role role = Role::Occluder;        ///< object, holder (interacting), occluder or table (background)
   std::string shape;                 ///< box, sphere, capsule, sheet, cloth, mesh, plane
   TriangleMesh mesh;                 ///< at rest, body frame
   std::string mesh_file;             ///< shape mesh: the file it was read from
   Eigen::Vector3f colour{0.5f, 0.5f, 0.5f};  ///< RGB in [0, 1]
-  Motion motion;
+  Motion motion;                     ///< its pose over time (a fixed pose: one waypoint)
   /// Cloth only: travelling wave and bend along body x (see deform_sheet).
   double wave_amplitude = 0.0, wave_length = 0.2, wave_frequency = 0.0, bend = 0.0;
+  /** \var wave_length
+   *  \brief Cloth only: wavelength of the travelling wave [m].
+   *  \var wave_frequency
+   *  \brief Cloth only: frequency of the travelling wave [Hz].
+   *  \var bend
+   *  \brief Cloth only: bend along body x, dz = bend x^2 [1/m].
+   */
   /// Probability that a pixel showing this body has no depth when the
   /// sensor's noise is on: a dark or shiny surface [0, 1].
   double dropout = 0.0;
+  /// \brief True for a cloth, whose mesh world_mesh() deforms with time.
   [[nodiscard]] bool deformable() const { return shape == "cloth"; }
   /// \brief The body's mesh in the world frame at time t.
   [[nodiscard]] TriangleMesh world_mesh(double t) const;
@@ -63,7 +71,7 @@ struct Body {
 
 /// \brief Depth noise of the simulated sensor.
 struct NoiseModel {
-  bool enabled = true;
+  bool enabled = true;          ///< noise and dropouts on (the bodies' `dropout` too)
   double depth_sigma = 0.001;   ///< Gaussian sigma at 1 m; grows with depth^2 [m]
   double grazing_deg = 78.0;    ///< pixels seen more obliquely than this are missing [deg]
   double edge_jump = 0.03;      ///< depth step that makes a pixel an edge [m]
@@ -75,7 +83,7 @@ struct SensorSettings {
   CameraIntrinsics intrinsics;  ///< default: the `fast-320` preset
   double min_depth = 0.1;       ///< [m]
   double max_depth = 3.0;       ///< [m]
-  NoiseModel noise;
+  NoiseModel noise;             ///< depth noise and dropouts
 };
 
 /// \brief Intrinsics presets: `d435-640` (640x480, D435-like) and `fast-320` (320x240).
@@ -95,13 +103,15 @@ struct Scenario {
   double rate = 30.0;     ///< sensor rate [Hz]
   unsigned seed = 1;      ///< sensor noise seed (frame k uses seed and k)
   Variation variation;    ///< what with_seed() draws for seeds other than 0
-  SensorSettings sensor;
+  SensorSettings sensor;  ///< the simulated RGB-D sensor
   Eigen::Isometry3d wMc_start = Eigen::Isometry3d::Identity();  ///< camera start pose
   std::vector<Body> bodies;  ///< the object first
-  EstimatorParams estimator;
+  EstimatorParams estimator;  ///< the file's `estimator` settings (preset and overrides)
   std::string robot = "camera";  ///< camera, viper850, afma6
   std::map<std::string, std::string> controller;  ///< law, gain, ... (read by the servo layer)
+  /// \brief The sphere's radius the scenario asks for, else the estimator's default [m].
   double r_sphere() const { return estimator.r_sphere.value_or(EstimatorSettings{}.r_sphere); }
+  /// \brief The seed resolution the scenario asks for, else the estimator's default [m].
   double r_seed() const { return estimator.r_seed.value_or(EstimatorSettings{}.r_seed); }
 };
 

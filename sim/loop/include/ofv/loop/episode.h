@@ -57,10 +57,10 @@ enum class ObjectSelect {
  * resolve_episode().
  */
 struct EpisodeSetup {
-  sim::Scenario scenario;
+  sim::Scenario scenario;  ///< the world, already varied for `seed` (sim::with_seed)
   LoopSettings loop;  ///< the per-frame policy: estimator, method, controller, safety
-  RobotKind robot = RobotKind::Camera;
-  PerceptionMode perception = PerceptionMode::Full;
+  RobotKind robot = RobotKind::Camera;  ///< what carries the camera (setting `robot`)
+  PerceptionMode perception = PerceptionMode::Full;  ///< where the estimator's input comes from
   /// The front end's settings (perception full or labels) that users set
   /// (ofv::perception_settings_table()); its sphere and seed resolution
   /// come from the estimator's.
@@ -129,6 +129,7 @@ inline constexpr double kMaxEpisodeFrames = 86400.0 * 1000.0;
  *        time, a simulated sensor rendering the scenario live from the arm's
  *        current camera pose (sim::LiveSource), and the loop of `ofv run`
  *        (ofv::run_on_robot) with its frame timing, stale frames and stop flag.
+ * \param setup    the episode, with robot viper850 or afma6.
  * \param stop     a signal handler's flag, or nullptr.
  * \param observer sees every frame (e.g. to print the commands).
  * \return the episode, summarised from the simulator's ground truth at each frame.

@@ -51,8 +51,8 @@ class EpisodeStore {
 
 /// \brief A finished episode as read back from its `<id>.json`.
 struct EpisodeRow {
-  EpisodeSpec spec;
-  EpisodeMetrics metrics;
+  EpisodeSpec spec;            ///< which episode: scenario, variant, seed
+  EpisodeMetrics metrics;      ///< its metrics as recorded
   std::string trajectory_csv;  ///< path of its trajectory file
 };
 

@@ -21,13 +21,13 @@ inline constexpr std::size_t kMaxVariants = kMaxEpisodes;
 
 /// \brief One column of the comparison: a named list of settings `name=value`.
 struct Variant {
-  std::string name;
+  std::string name;  ///< unique in the grid; `variant,axis=value,...` after expanding axes
   std::vector<std::pair<std::string, std::string>> settings;  ///< applied in order
 };
 
 /// \brief The settings grid of `ofv compare --grid GRID.yaml` (see docs/compare.md).
 struct Grid {
-  std::string name = "grid";
+  std::string name = "grid";      ///< a label (`name:` of the file)
   int seeds = 3;                  ///< seeds per scenario x variant, 1..kMaxSeeds (`--seeds` overrides)
   std::vector<Variant> variants;  ///< after expanding `axes` (cartesian product)
 };

@@ -22,10 +22,11 @@ namespace ofv {
 
 /// \brief Wall-clock time spent in each stage of one closed-loop step [s].
 struct StageTimes {
-  double render = 0.0;
-  double perception = 0.0;
-  double estimate = 0.0;
-  double control = 0.0;
+  double render = 0.0;      ///< rendering the frame (a rehearsal: waiting for its live source)
+  double perception = 0.0;  ///< the front end, or the simulator's ground-truth problem
+  double estimate = 0.0;    ///< view selection (LoopStep::estimate_s)
+  double control = 0.0;     ///< controller and safety filter (LoopStep::control_s)
+  /// \brief The sum of the four stages [s].
   [[nodiscard]] double total() const { return render + perception + estimate + control; }
 };
 
@@ -69,10 +70,20 @@ struct ScoreSummary {
 /// \brief The perception block of an episode (`metrics.json` "perception").
 struct PerceptionSummary {
   ScoreSummary object_precision, object_recall, occluder_precision, occluder_recall;
+  /** \var object_precision
+   *  \brief PerceptionScores::object_precision over the episode.
+   *  \var object_recall
+   *  \brief PerceptionScores::object_recall over the episode.
+   *  \var occluder_precision
+   *  \brief PerceptionScores::occluder_precision over the episode.
+   *  \var occluder_recall
+   *  \brief PerceptionScores::occluder_recall over the episode.
+   */
   ScoreSummary centroid_error;  ///< [m]
   ScoreSummary hidden_error;    ///< [m]
   /// Frames where the front end lost the object while the true visible fraction was at least 0.5.
   int lost_half_visible = 0;
+  /// \brief True when some frame was scored (full or labels perception).
   [[nodiscard]] bool scored() const { return object_recall.frames > 0; }
 };
 
@@ -92,23 +103,23 @@ struct OcclusionEvent {
 
 /// \brief Summary of an episode.
 struct EpisodeMetrics {
-  int steps = 0;
+  int steps = 0;                        ///< frame periods (StepRecord) summarised
   double duration = 0.0;                ///< simulated [s]
-  double mean_visible_fraction = 0.0;
-  double min_visible_fraction = 0.0;
+  double mean_visible_fraction = 0.0;   ///< time-weighted mean of the true visible fraction [0, 1]
+  double min_visible_fraction = 0.0;    ///< its lowest value over the steps [0, 1]
   double time_below_threshold = 0.0;    ///< simulated time with visibility < threshold [s]
-  double visibility_threshold = 0.9;
-  std::vector<OcclusionEvent> occlusions;
+  double visibility_threshold = 0.9;    ///< the `threshold` of summarise() [0, 1]
+  std::vector<OcclusionEvent> occlusions;  ///< every occlusion event, in time order
   std::optional<double> max_recovery_time;   ///< worst recovery over events; none if one never recovered
-  int unrecovered_occlusions = 0;
-  double mean_angular_error_deg = 0.0;
+  int unrecovered_occlusions = 0;       ///< events still going on at the end
+  double mean_angular_error_deg = 0.0;  ///< time-weighted mean of StepRecord::angular_error_deg [deg]
   double path_length = 0.0;             ///< camera path [m]
   double max_sphere_distance_error = 0.0;  ///< max |distance to centroid - r_sphere| [m]
   double max_linear_speed = 0.0;        ///< [m/s]
   double max_angular_speed = 0.0;       ///< [rad/s]
   StageTimes mean_times;                ///< mean compute time per stage [s]
   StageTimes max_times;                 ///< worst step per stage [s]
-  int estimator_iterations_max = 0;
+  int estimator_iterations_max = 0;     ///< most push steps of one estimate
   std::vector<std::pair<std::string, int>> status_counts;  ///< steps per status
   PerceptionSummary perception;  ///< empty (scored() false) with ground-truth perception
 };
@@ -117,6 +128,7 @@ struct EpisodeMetrics {
  * \brief Summarises an episode.
  * \param steps  records in time order, one per frame period.
  * \param threshold  visibility counted as "in view" [0, 1].
+ * \param hold   how long the visibility must stay back for an event to end [s].
  * Each step stands for the interval until the next one (the last for the
  * mean period). An occlusion event starts when the visibility falls below
  * `threshold` and ends at the first step from which it stays at or above the

@@ -25,6 +25,8 @@ namespace ofv {
 /**
  * \brief Checks that every variant's settings apply to every scenario, so a
  *        typo fails at once rather than hours into a sweep.
+ * \param scenarios   names and paths, as scenario_set() gives them
+ * \param grid        the variants to check
  * \param grid_source the grid's file, named in errors with the variant
  * \throws std::invalid_argument naming the grid file, the variant, the
  *         setting and the value.

@@ -22,9 +22,9 @@ namespace ofv {
 
 /// \brief An 8-bit colour picture, row-major, 3 bytes per pixel (R G B).
 struct RgbPicture {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgb;
+  int width = 0;                  ///< [px]
+  int height = 0;                 ///< [px]
+  std::vector<std::uint8_t> rgb;  ///< width x height x 3 bytes
 };
 
 /// \brief What the scene view of one frame shows (world frame, metres).
@@ -51,7 +51,9 @@ struct SceneState {
  *        each confirmed occluder track as an orange arrow to where it will
  *        be in 0.5 s with its id, and a line of text (time, visible
  *        fraction and status when known).
+ * \param state what to draw.
  * \param path the camera positions so far (world) [m].
+ * \param r_sphere the sphere's radius [m].
  */
 [[nodiscard]] RgbPicture scene_picture(const SceneState& state,
                                        const std::vector<Eigen::Vector3d>& path, double r_sphere);

@@ -15,7 +15,7 @@ namespace ofv {
 
 /// \brief Mean and 95 % confidence half-width (Student t) of a sample.
 struct Interval {
-  double mean = 0.0;
+  double mean = 0.0;        ///< mean of the finite values (NaN if none)
   double half_width = 0.0;  ///< 0 with fewer than two values or no spread
   int n = 0;                ///< finite values used
 };
@@ -35,8 +35,8 @@ struct MetricColumn {
 
 /// \brief The episodes of one scenario x variant: its seeds.
 struct EpisodeGroup {
-  std::string scenario;
-  Variant variant;
+  std::string scenario;          ///< scenario name
+  Variant variant;               ///< the variant, with its settings
   std::vector<EpisodeRow> rows;  ///< in the order of the rows grouped
   /// \brief Mean and interval of `column` over the rows.
   [[nodiscard]] Interval interval(const MetricColumn& column) const;
@@ -45,9 +45,9 @@ struct EpisodeGroup {
 /// \brief Episodes grouped by scenario x variant, every list in the order
 ///        the rows first name it (the sweep order for load_episodes() rows).
 struct EpisodeGroups {
-  std::vector<std::string> scenarios;
+  std::vector<std::string> scenarios;  ///< scenario names
   std::vector<std::string> variants;  ///< variant names
-  std::vector<EpisodeGroup> groups;
+  std::vector<EpisodeGroup> groups;   ///< one per scenario x variant that ran
   /// \brief The group of a scenario and variant name; nullptr if none ran.
   [[nodiscard]] const EpisodeGroup* find(const std::string& scenario,
                                          const std::string& variant) const;

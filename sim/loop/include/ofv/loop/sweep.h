@@ -24,12 +24,12 @@ namespace ofv {
 struct EpisodeSpec {
   int index = 0;           ///< position in the whole sweep (sharding and ordering)
   std::string scenario;    ///< scenario name (file stem)
-  std::string scenario_path;
+  std::string scenario_path;  ///< the scenario's file, as the runner loads it
   /// Fingerprint of the scenario's files (scenario_fingerprint()): an edited
   /// scenario or mesh is another episode.
   std::string scenario_hash;
-  Variant variant;
-  int seed = 0;
+  Variant variant;  ///< its name and settings
+  int seed = 0;     ///< the scenario's k-th random world (sim::with_seed)
   /**
    * \brief What makes two episodes the same: the scenario's name and the
    *        fingerprint of its files, the variant's name, its settings in the
@@ -86,8 +86,8 @@ void check_sweep_size(std::size_t scenarios, std::size_t variants, int seeds);
 
 /// \brief Part `k` (1-based) of `n` of a sweep.
 struct Shard {
-  int k = 1;
-  int n = 1;
+  int k = 1;  ///< this part, 1..n
+  int n = 1;  ///< parts in all
 };
 
 /// \brief Parses `K/N` (e.g. `2/8`), the value of `--shard`.
@@ -100,7 +100,7 @@ struct Shard {
 
 /// \brief What an episode gives back.
 struct EpisodeOutcome {
-  EpisodeMetrics metrics;
+  EpisodeMetrics metrics;  ///< the episode's summary (summarise())
   std::vector<StepRecord> steps;  ///< for the time plots and trajectory files
   /// Every setting as the episode resolved it (episode_settings_table()),
   /// recorded with the episode; empty when the runner does not say.
@@ -131,6 +131,9 @@ struct SweepOptions {
  * `options.jobs`: episodes are independent and each is written to its own
  * files.
  * \param plan the whole sweep (every part), e.g. from plan_episodes().
+ * \param runner runs one episode (e.g. simulation_runner()), from several threads at once.
+ * \param out_dir the sweep's folder, created if missing.
+ * \param options jobs, progress bar, part.
  * \return the number of episodes run (not resumed).
  * \throws std::invalid_argument, before anything runs or is written, if
  *         `options.jobs` is outside 0..kMaxJobs, the part is not 1 <= K <= N,
