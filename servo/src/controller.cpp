@@ -3,7 +3,10 @@
 
 #include "ofv/servo/target_pose.h"
 
+#include <visp3/visual_features/vpFeatureThetaU.h>
+#include <visp3/visual_features/vpFeatureTranslation.h>
 #include <visp3/vs/vpAdaptiveGain.h>
+#include <visp3/vs/vpServo.h>
 
 #include <cmath>
 #include <stdexcept>
@@ -55,7 +58,31 @@ vpColVector saturate(const vpColVector& v, double max_linear, double max_angular
   return out;
 }
 
-ViewController::ViewController(const ControllerSettings& settings) : settings_(settings) { validate(settings_); }
+struct ViewController::Task {
+  vpServo servo;
+  FeatureSphereView sphere, sphere_star;  // s* = 0
+  vpFeatureTranslation translation{vpFeatureTranslation::cdMc};
+  vpFeatureThetaU rotation{vpFeatureThetaU::cdRc};
+
+  explicit Task(ControllerSettings::Law law) {
+    servo.setServo(vpServo::EYEINHAND_CAMERA);
+    servo.setInteractionMatrixType(vpServo::CURRENT);
+    if (law == ControllerSettings::Law::Pbvs) {
+      servo.addFeature(translation);
+      servo.addFeature(rotation);
+    } else {
+      servo.addFeature(sphere, sphere_star);
+    }
+  }
+};
+
+ViewController::ViewController(const ControllerSettings& settings) : settings_(settings) {
+  validate(settings_);
+  task_ = std::make_unique<Task>(settings_.law);
+}
+ViewController::~ViewController() = default;
+ViewController::ViewController(ViewController&&) noexcept = default;
+ViewController& ViewController::operator=(ViewController&&) noexcept = default;
 
 double ViewController::lambda(double error_norm) const {
   if (!settings_.adaptive_gain) return settings_.gain;
@@ -82,23 +109,16 @@ vpColVector ViewController::update(const Eigen::Vector3d& tf, const Eigen::Vecto
   if (settings_.law == ControllerSettings::Law::Pbvs) {
     const vpHomogeneousMatrix wMcd = target_pose(target, centroid, wMc);
     const vpHomogeneousMatrix cdMc = wMcd.inverse() * wMc;
-    vpFeatureTranslation t(vpFeatureTranslation::cdMc);
-    vpFeatureThetaU tu(vpFeatureThetaU::cdRc);
-    t.buildFrom(cdMc);
-    tu.buildFrom(cdMc);
-    vpServo task;
-    task.setServo(vpServo::EYEINHAND_CAMERA);
-    task.setInteractionMatrixType(vpServo::CURRENT);
-    task.addFeature(t);
-    task.addFeature(tu);
+    task_->translation.buildFrom(cdMc);
+    task_->rotation.buildFrom(cdMc);
     vpColVector e(6);
     for (unsigned i = 0; i < 3; ++i) {
-      e[i] = t[i];
-      e[i + 3] = tu[i];
+      e[i] = task_->translation[i];
+      e[i + 3] = task_->rotation[i];
     }
     last_error_ = e.frobeniusNorm();
-    task.setLambda(lambda(last_error_));
-    v = task.computeControlLaw();
+    task_->servo.setLambda(lambda(last_error_));
+    v = task_->servo.computeControlLaw();
   } else {
     const Eigen::Isometry3d cMw = to_eigen(wMc).inverse();
     if ((cMw * centroid).z() <= 1e-6) return zero;  // the object is behind the camera: do not guess
@@ -108,12 +128,11 @@ vpColVector ViewController::update(const Eigen::Vector3d& tf, const Eigen::Vecto
       // Antipodal target: every tangent direction is as short; lean towards the camera's x.
       aim += 1e-3 * (target - centroid).norm() * to_eigen(wMc).linear().col(0);
     }
-    FeatureSphereView s;
-    s.build(to_visp(cMw), vpColVector{centroid.x(), centroid.y(), centroid.z()},
-            vpColVector{aim.x(), aim.y(), aim.z()}, r_sphere);
-    const vpColVector e = s.get_s();
-    last_error_ = e.frobeniusNorm();
-    v = -lambda(last_error_) * s.interaction().pseudoInverse() * e;
+    task_->sphere.build(to_visp(cMw), vpColVector{centroid.x(), centroid.y(), centroid.z()},
+                        vpColVector{aim.x(), aim.y(), aim.z()}, r_sphere);
+    last_error_ = task_->sphere.get_s().frobeniusNorm();
+    task_->servo.setLambda(lambda(last_error_));
+    v = task_->servo.computeControlLaw();
   }
   if (!finite(v)) return zero;
   return saturate(v, settings_.max_linear_speed, settings_.max_angular_speed);

@@ -10,9 +10,6 @@
 #include <Eigen/Core>
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
-#include <visp3/visual_features/vpFeatureThetaU.h>
-#include <visp3/visual_features/vpFeatureTranslation.h>
-#include <visp3/vs/vpServo.h>
 
 #include <memory>
 #include <optional>
@@ -45,12 +42,24 @@ void validate(const ControllerSettings& settings);
  * \brief Computes the camera velocity towards a view on the sphere, one frame
  *        at a time; the desired feature is re-set at every call.
  *
+ * One vpServo task (eye-in-hand, interaction matrix of the current
+ * features), made once as ViSP's tutorials do: its features
+ * (FeatureSphereView, or vpFeatureTranslation and vpFeatureThetaU for
+ * PBVS) are built again from each frame's pose and target, its gain set
+ * from the error, then computeControlLaw(). Movable, not copyable (the task
+ * points to its features).
+ *
  * Never returns a non-finite or over-limit command: invalid inputs give zero.
  */
 class ViewController {
  public:
   /// \throws std::invalid_argument naming the field and value when a setting is out of range.
   explicit ViewController(const ControllerSettings& settings = {});
+  ~ViewController();
+  ViewController(ViewController&&) noexcept;             ///< moves the task and its features
+  ViewController& operator=(ViewController&&) noexcept;  ///< moves the task and its features
+  ViewController(const ViewController&) = delete;
+  ViewController& operator=(const ViewController&) = delete;
 
   /**
    * \param tf        the view to reach (world frame) [m].
@@ -73,7 +82,10 @@ class ViewController {
  private:
   [[nodiscard]] double lambda(double error_norm) const;
 
+  struct Task;  // the vpServo task and the features it points to
+
   ControllerSettings settings_;
+  std::unique_ptr<Task> task_;
   std::optional<Eigen::Vector3d> filtered_;
   double last_error_ = 0.0;
 };
