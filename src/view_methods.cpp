@@ -129,10 +129,6 @@ ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& c
   return best;
 }
 
-const char* to_string(NoFreeView m) {
-  return m == NoFreeView::BestIterate ? "best_iterate" : "most_visible";
-}
-
 ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
                              const Eigen::Vector3d& current, const std::vector<Eigen::Vector3d>& others,
                              const NoFreeViewSettings& settings) {

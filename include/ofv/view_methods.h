@@ -82,18 +82,8 @@ struct ScoredView {
                                           const Eigen::Vector3d& centroid, double r_sphere,
                                           const SamplingSettings& sampling);
 
-/// \brief What the loop does when the estimator finds no occlusion-free view
-///        (status not_converged): where no free view exists, or none was found.
-enum class NoFreeView {
-  BestIterate,  ///< the spec's t_f: the visited iterate with the fewest points in the clearance disc
-  MostVisible,  ///< hold the current view unless a nearby one sees clearly more (most_visible_view)
-};
-/// \brief The word in settings and files: best_iterate, most_visible.
-[[nodiscard]] const char* to_string(NoFreeView m);
-
 /// \brief Settings of most_visible_view().
 struct NoFreeViewSettings {
-  NoFreeView mode = NoFreeView::MostVisible;  ///< what the loop does without a free view
   double step_deg = 8.0;          ///< neighbours of the current view, this far from it seen from C [deg]
   double margin = 0.05;           ///< a view must see this much more of the object than the current one
   double occluder_radius = 0.02;  ///< an occluder point blocks lines of sight passing closer than this [m]

@@ -191,13 +191,6 @@ SettingsTable<LoopSettings> make_table() {
           l.tracker.max_misses = static_cast<int>(parse_integer("track_max_misses", v, 0, 1000));
         },
         [](const L& l) { return std::to_string(l.tracker.max_misses); });
-  t.add({"no_free_view", "best_iterate | most_visible", to_string(d.no_free_view.mode), "",
-         "when the estimator finds no free view: the spec's best iterate, or hold unless a nearby view sees clearly more"},
-        [](L& l, const std::string& v) {
-          l.no_free_view.mode = parse_word<NoFreeView>(
-              "no_free_view", v, {{"best_iterate", NoFreeView::BestIterate}, {"most_visible", NoFreeView::MostVisible}});
-        },
-        [](const L& l) { return std::string(to_string(l.no_free_view.mode)); });
   t.add({"retreat_drop", "number in [0, 1]", format_number(d.no_free_view.retreat_drop), "",
          "the fraction of the object the camera may see less, because it moved, than at the view that showed the "
          "most in the last 0.5 s, before it goes back there and holds (not when occluders moved in or came there "
@@ -211,10 +204,10 @@ SettingsTable<LoopSettings> make_table() {
          "it could stop), the camera climbs to a nearby view that sees clearly more, or holds"},
         [](L& l, const std::string& v) { l.no_free_view.look_ahead = parse_bool("look_ahead", v); },
         [](const L& l) { return format_bool(l.no_free_view.look_ahead); });
-  t.add({"no_free_view_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
-         "no_free_view=most_visible: a view must see this fraction more of the object than the current one, 0 to 1"},
+  t.add({"look_ahead_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
+         "look_ahead: a nearby view the camera climbs to must see this fraction more of the object than the current one, 0 to 1"},
         [](L& l, const std::string& v) {
-          l.no_free_view.margin = parse_number("no_free_view_margin", v, 0.0, 1.0, false);
+          l.no_free_view.margin = parse_number("look_ahead_margin", v, 0.0, 1.0, false);
         },
         [](const L& l) { return format_number(l.no_free_view.margin); });
   t.add({"max_linear_accel", "number in (0, 100]", format_number(d.safety.max_linear_accel), "m/s^2",
@@ -496,25 +489,15 @@ std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& proble
     }
     case ViewMethod::Estimator: break;
   }
-  ViewStatus status = estimate.status;
-  Eigen::Vector3d target = estimate.tf;
   if (settings_.target_hysteresis && previous_target_ && estimate.iterations > 0) {
     // t0 is occluded: continue from the previous target (the spec's warm
     // start), which stays where it is while clear and otherwise moves to
     // the nearest clear view. While t0 is clear, t0 is the target.
     const std::optional<ViewEstimate> warm = kept ? kept : from_previous_target(problem);
-    if (is_free(warm->status)) {
-      status = warm->status;
-      target = warm->tf;
-    }
+    if (is_free(warm->status)) return warm->tf;
   }
-  if (!is_free(status) && settings_.no_free_view.mode == NoFreeView::MostVisible) {
-    // No free view: hold, or climb towards a view that sees clearly more.
-    std::vector<Eigen::Vector3d> others{estimate.tf, estimate.t0};
-    if (previous_target_) others.push_back(*previous_target_);
-    return most_visible_view(problem, estimate.centroid, r_sphere, *problem.camera, others, settings_.no_free_view).view;
-  }
-  return target;
+  // Without a free view, the spec's best iterate.
+  return estimate.tf;
 }
 
 Eigen::Matrix3Xd ViewLoop::predicted(const Eigen::Vector3d& centroid) const {

@@ -139,7 +139,7 @@ TEST(Episode, SettingsAreValidatedByName) {
            {"method", "nbv"}, {"gain", "-1"}, {"robot", "puma"}, {"perception", "magic"},
            {"step", "big"}, {"speed", "1"}, {"sampling_candidates", "1.5"}, {"seed", "-2"},
            {"latency", "31"}, {"latency", "-1"}, {"anticipation", "psychic"}, {"anticipation_horizon", "0"},
-           {"no_free_view", "wander"}, {"track_gate", "inf"}}) {
+           {"look_ahead_margin", "2"}, {"track_gate", "inf"}}) {
     try {
       (void)resolve_episode(s, {{name, value}});
       ADD_FAILURE() << name << "=" << value << " accepted";

@@ -121,32 +121,6 @@ TEST(ViewLoop, AnticipationLeavesBeforeTheOccluderArrives) {
   EXPECT_LE(ahead + 8, reactive) << "anticipating " << ahead << ", reactive " << reactive;
 }
 
-TEST(ViewLoop, WithoutAFreeViewItHoldsStill) {
-  // The patch inside a dense shell of occluders: no view is free. The spec's
-  // best iterate lies somewhere else on the sphere; most_visible keeps the
-  // camera where it is (the target is the camera, nothing moves).
-  ViewProblem caged = patch(false);
-  const Eigen::Matrix3Xd dirs = fibonacci_directions(600);
-  caged.occluders = (0.12 * dirs).colwise() + Eigen::Vector3d(0, 0, 0.5);
-  LoopSettings settings;
-  settings.estimator.max_iterations = 60;
-  settings.no_free_view.mode = NoFreeView::BestIterate;
-  ViewLoop wander(settings);
-  const vpHomogeneousMatrix wMc;
-  const LoopStep w = wander.step(observed(caged, wMc, 0.0), 1.0 / 30.0);
-  ASSERT_EQ(w.status, StepStatus::NotConverged);
-  ASSERT_TRUE(w.target);
-  EXPECT_GT(w.target->norm(), 1e-3);
-  settings.no_free_view.mode = NoFreeView::MostVisible;
-  ViewLoop hold(settings);
-  for (int k = 0; k < 3; ++k) {
-    const LoopStep h = hold.step(observed(caged, wMc, 0.0), 1.0 / 30.0);
-    ASSERT_TRUE(h.target);
-    EXPECT_LT(h.target->norm(), 1e-9);
-    EXPECT_LT(speed(h.velocity), 1e-9);
-  }
-}
-
 // What hides the object once the camera has left the origin for the
 // estimator's view (a cluster in front of a corner of the patch occludes t0
 // there), while the frame shows half as much of the object.
