@@ -103,16 +103,22 @@ class CommandLines {
   CommandLines& operator=(const CommandLines&) = delete;
 
   /// One JSON line per command: frame, time, status, twist (17 digits),
-  /// safety action, the confirmed occluder tracks seen in the frame (id,
-  /// position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
+  /// safety action, the loop's mode, the guard that moved it and the
+  /// proposer of the target, the confirmed occluder tracks seen in the frame
+  /// (id, position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
   void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,
-             const std::vector<OccluderTrack>& tracks = {}) {
+             const LoopStep* step = nullptr) {
     if (!out_) return;
     std::fprintf(out_, "{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
     for (unsigned i = 0; i < 6; ++i) std::fprintf(out_, "%s%.17g", i ? ", " : "", v[i]);
-    std::fprintf(out_, "], \"safety\": \"%s\", \"tracks\": [", safety);
+    std::fprintf(out_, "], \"safety\": \"%s\", ", safety);
+    if (step) {
+      std::fprintf(out_, "\"mode\": \"%s\", \"guard\": \"%s\", \"proposer\": \"%s\", ", to_string(step->mode),
+                   to_string(step->guard), to_string(step->proposer));
+    }
+    std::fprintf(out_, "\"tracks\": [");
     bool first = true;
-    for (const OccluderTrack& k : tracks) {
+    for (const OccluderTrack& k : step ? step->tracks : std::vector<OccluderTrack>{}) {
       if (!k.confirmed || k.points.cols() == 0) continue;
       std::fprintf(out_, "%s{\"id\": %d, \"p\": [%.6g, %.6g, %.6g], \"v\": [%.6g, %.6g, %.6g], \"sigma_v\": %.6g}",
                    first ? "" : ", ", k.id, k.position.x(), k.position.y(), k.position.z(), k.velocity.x(),
@@ -268,7 +274,7 @@ Command add_run_command(CLI::App& app) {
               bool user_quit = false;  // the display's quit, not a signal
               const auto print = [&](const RobotLoopFrame& f) {
                 lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
-                            to_string(f.step->safety), f.step->tracks);
+                            to_string(f.step->safety), f.step);
 #if defined(OFV_HAVE_DISPLAY)
                 // The user ending the run stops it as SIGTERM does.
                 if (display && !display->observe(f)) {

@@ -3,6 +3,7 @@
 
 #include "ofv/estimator_settings.h"
 #include "ofv/servo/target_pose.h"
+#include "world_model.h"
 
 #include <algorithm>
 #include <chrono>
@@ -27,8 +28,8 @@ constexpr std::size_t kReservedOcclusionPoints = 250'000;
 constexpr double kAway = 0.01;     // [m]: the camera has moved from a view
 constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
 // A steady target: within kSteadyDeg of the previous frame's for
-// kSteadyFrames frames (ViewLoop::retreat); on the way there, only a loss
-// of more than kSteadyLoss of what the camera showed counts.
+// kSteadyFrames frames; on the way there, only a loss of more than
+// kSteadyLoss of what the camera showed counts (guard camera_cost_view).
 constexpr double kSteadyDeg = 10.0;
 constexpr int kSteadyFrames = 10;
 constexpr double kSteadyLoss = 0.5;
@@ -250,140 +251,286 @@ const char* to_string(StepStatus status) {
   return "?";
 }
 
-ViewLoop::ViewLoop(const LoopSettings& settings)
-    : settings_(settings),
-      estimator_(settings.estimator.resolve()),
-      controller_(settings.controller),
-      safety_(settings.safety),
-      tracker_(settings.tracker) {
-  if (settings_.sampling.candidates < 1 || !(settings_.sampling.occluder_radius > 0.0)) {
-    throw std::invalid_argument("sampling settings: candidates must be >= 1 and occluder_radius positive");
+const char* to_string(LoopMode mode) {
+  switch (mode) {
+    case LoopMode::Pursue: return "pursue";
+    case LoopMode::Hold: return "hold";
+    case LoopMode::WayBack: return "way_back";
+    case LoopMode::Waiting: return "waiting";
+    case LoopMode::Lost: return "lost";
   }
+  return "?";
 }
 
-void ViewLoop::reset() {
-  previous_view_.reset();
-  previous_target_.reset();
-  controller_.reset();
-  safety_.reset();
-  tracker_.reset();
-  best_seen_.reset();
-  held_.reset();
-  low_frames_ = 0;
-  target_direction_.reset();
-  steady_frames_ = 0;
-  release_when_steady_ = false;
-  steadiness_ends_holds_ = false;
-  t0_was_clear_ = false;
-  last_centroid_.reset();
-  track_history_.clear();
+const char* to_string(Guard guard) {
+  switch (guard) {
+    case Guard::None: return "none";
+    case Guard::CameraCostView: return "camera_cost_view";
+    case Guard::T0Clear: return "t0_clear";
+    case Guard::SceneChanged: return "scene_changed";
+    case Guard::TargetSteady: return "target_steady";
+    case Guard::ObjectLost: return "object_lost";
+    case Guard::ObjectLostNoView: return "object_lost_no_view";
+    case Guard::BackThere: return "back_there";
+    case Guard::AwayAgain: return "away_again";
+    case Guard::ObjectFound: return "object_found";
+  }
+  return "?";
 }
 
-std::optional<Eigen::Vector3d> ViewLoop::retreat(const ViewProblem& problem, Eigen::Index seen,
-                                                 const ViewEstimate& estimate, double shown, double dt,
-                                                 const std::optional<Eigen::Vector3d>& target) {
-  const NoFreeViewSettings& s = settings_.no_free_view;
-  const Eigen::Vector3d& c = estimate.centroid;
-  const Eigen::Vector3d& here = *problem.camera;
-  if (s.retreat_drop <= 0.0) return target;
-  constexpr int kFrames = 2;      // a loss counts when it lasts this many frames (one frame is noise)
-  constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
-  const double keep = 1.0 - s.retreat_drop;
-  // A steady free view: the estimator converges, frame after frame, to a
-  // target within kSteadyDeg of the previous frame's, for kSteadyFrames
-  // frames. A way around an occluder stays where it is, and the camera may
-  // lose some of the object on its way there (past the occluder's edge):
-  // unless it loses more than half of what it showed (kSteadyLoss), that
-  // is no reason to retreat. A hold that began while the target was not
-  // yet steady (an occluder arriving) ends when it is. Gaps that only
-  // perception's noise opens (an object in a cage of occluders) mostly
-  // move from frame to frame; a hold that began on the way to a steady
-  // target (it failed) is not ended by steadiness. Nor is any hold until
-  // t0 has been clear: since the first frame (until then no occluder has
-  // arrived: what hides t0 was there from the start, like a cage), and
-  // again after a hold that steadiness ended (a steady target failed: in
-  // a still cage the gaps are steady too).
-  if (target && estimate.status == ViewStatus::Converged) {
-    const Eigen::Vector3d direction = (*target - c).normalized();
-    const bool near = target_direction_ && direction.dot(*target_direction_) >= std::cos(kSteadyDeg * EIGEN_PI / 180.0);
-    steady_frames_ = near ? steady_frames_ + 1 : 1;
-    target_direction_ = direction;
-  } else {
-    steady_frames_ = 0;
-    target_direction_.reset();
+const char* to_string(Proposer proposer) {
+  switch (proposer) {
+    case Proposer::None: return "none";
+    case Proposer::Estimate: return "estimate";
+    case Proposer::Anticipated: return "anticipated";
+    case Proposer::WarmStart: return "warm_start";
+    case Proposer::Climb: return "climb";
+    case Proposer::Here: return "here";
+    case Proposer::BestSeen: return "best_seen";
+    case Proposer::InitialView: return "initial_view";
+    case Proposer::Sampling: return "sampling";
   }
-  const bool steady = steady_frames_ >= kSteadyFrames;
-  if (estimate.iterations == 0) steadiness_ends_holds_ = t0_was_clear_ = true;
-  if (held_) {
-    const bool there = (here - held_->position).norm() <= kAway;
-    low_frames_ = there && shown < keep * held_->shown ? low_frames_ + 1 : 0;
-    const bool hold = estimate.iterations > 0 && low_frames_ < kReleaseFrames;
-    if (hold && !(steady && release_when_steady_)) return held_->position;
-    if (hold) steadiness_ends_holds_ = false;  // steadiness ended it
-    held_.reset();  // t0 clear, or back there it keeps showing much less: the scene changed
-    best_seen_ = SeenView{here, shown, problem.occluders.leftCols(seen), 0.0, track_positions()};
-    low_frames_ = 0;
-    return target;
+  return "?";
+}
+
+namespace {
+
+// A view and who proposed it (no view: the camera stops).
+struct Candidate {
+  std::optional<Eigen::Vector3d> view;
+  Proposer by = Proposer::None;
+};
+
+// The mode machine: each transition's mode, guard and next mode. In a
+// frame the current mode's guards are tried in this order and the first
+// that holds is taken (ViewLoop::Impl::found and lost evaluate them).
+struct Transition {
+  LoopMode from;
+  Guard guard;
+  LoopMode to;
+};
+constexpr Transition kTransitions[] = {
+    {LoopMode::Pursue, Guard::CameraCostView, LoopMode::Hold},
+    {LoopMode::Pursue, Guard::ObjectLost, LoopMode::WayBack},
+    {LoopMode::Pursue, Guard::ObjectLostNoView, LoopMode::Lost},
+    {LoopMode::Hold, Guard::T0Clear, LoopMode::Pursue},
+    {LoopMode::Hold, Guard::SceneChanged, LoopMode::Pursue},
+    {LoopMode::Hold, Guard::TargetSteady, LoopMode::Pursue},
+    {LoopMode::Hold, Guard::ObjectLost, LoopMode::WayBack},
+    {LoopMode::WayBack, Guard::BackThere, LoopMode::Waiting},
+    {LoopMode::WayBack, Guard::ObjectFound, LoopMode::Hold},
+    {LoopMode::Waiting, Guard::AwayAgain, LoopMode::WayBack},
+    {LoopMode::Waiting, Guard::ObjectFound, LoopMode::Hold},
+    {LoopMode::Lost, Guard::ObjectFound, LoopMode::Pursue},
+};
+
+}  // namespace
+
+struct ViewLoop::Impl {
+  explicit Impl(const LoopSettings& s)
+      : settings(s),
+        estimator(s.estimator.resolve()),
+        controller(s.controller),
+        safety(s.safety),
+        world(s.tracker, s.anticipation.min_speed) {
+    if (settings.sampling.candidates < 1 || !(settings.sampling.occluder_radius > 0.0)) {
+      throw std::invalid_argument("sampling settings: candidates must be >= 1 and occluder_radius positive");
+    }
   }
-  if (best_seen_) best_seen_->age += dt;
-  // What a view showed longer ago than kEvidence is no evidence any more
-  // (the occluders move): the current view starts again.
-  if (!best_seen_ || shown >= best_seen_->shown || !(best_seen_->age <= kEvidence)) {
-    best_seen_ = SeenView{here, shown, problem.occluders.leftCols(seen), 0.0, track_positions()};
-    low_frames_ = 0;
-    return target;
-  }
-  const bool away = (here - best_seen_->position).norm() > kAway;
-  const bool lost = shown < keep * best_seen_->shown && (!steady || shown < kSteadyLoss * best_seen_->shown);
-  low_frames_ = away && lost ? low_frames_ + 1 : 0;
-  if (low_frames_ < kFrames) return target;
-  const double r = estimator_.r_sphere;
-  const auto score = [&](const ViewProblem& scene, const Eigen::Vector3d& p) {
-    return score_view(scene, c, r, c + r * (p - c).normalized(), s.occluder_radius).visible_fraction;
+
+  // A camera position (world), how much of the object it showed, the
+  // occluders seen in that frame, how long ago that was and where the
+  // occluder tracks were.
+  struct SeenView {
+    Eigen::Vector3d position;
+    double shown = 0.0;
+    Eigen::Matrix3Xd occluders;
+    double age = 0.0;  // time since [s]
+    TrackPositions tracks;
   };
-  // The loss must come from the camera's own motion: with the occluders as
-  // they were when that view showed the most, and those of this frame known
-  // to stand still (revealed by the motion), here shows less than there by
-  // retreat_drop too. Occluders that moved in since cost the object
-  // wherever the camera is.
-  const Eigen::Matrix3Xd still = revealed_still(*best_seen_);
-  ViewProblem then = problem;
-  then.occluders.resize(3, best_seen_->occluders.cols() + still.cols());
-  then.occluders << best_seen_->occluders, still;
-  if (!(score(then, here) < keep * score(then, best_seen_->position))) return target;
-  // The frame's occluders must make that view clearly better, or at least
-  // not worse where they hide most of the object from here.
-  const double here_score = score(problem, here);
-  const double margin = here_score < 0.5 ? 0.0 : 0.1;
-  if (score(problem, best_seen_->position) < here_score + margin) return target;  // the occluders came there too
-  held_ = best_seen_;
-  release_when_steady_ = !steady && steadiness_ends_holds_;
-  low_frames_ = 0;
-  return held_->position;
+
+  // What one frame brings to the stages after the world model.
+  struct Frame {
+    const ViewProblem& problem;  // seen and presumed occluders
+    Eigen::Index seen;           // its first `seen` occluders were seen
+    const ViewEstimate& estimate;
+    Eigen::Vector3d here;
+    double shown;  // [m²]
+    double dt, age;
+  };
+
+  LoopStep step(const Observation& observation, double dt);
+  void reset();
+
+  // --- proposers
+  ViewEstimate estimate_view_counted(const ViewProblem& problem, const EstimatorSettings& settings);
+  std::optional<ViewEstimate> from_previous_target(const ViewProblem& problem);
+  Candidate pursue(const ViewProblem& problem, LoopStep& out);
+  Candidate look_ahead(const Frame& f, const Candidate& pursuit) const;
+  // --- the mode machine
+  void transition(Guard guard, LoopStep& out);
+  void update_steadiness(const Candidate& pursuit, const ViewEstimate& estimate);
+  void found(const Frame& f, LoopStep& out);
+  void lost(const Eigen::Vector3d& here, double dt, LoopStep& out);
+  bool camera_cost_view(const Frame& f, bool steady);
+  [[nodiscard]] SeenView seen_here(const Frame& f) const {
+    return SeenView{f.here, f.shown, f.problem.occluders.leftCols(f.seen), 0.0, world.positions()};
+  }
+
+  LoopSettings settings;
+  EstimatorSettings estimator;
+  ViewController controller;
+  SafetyFilter safety;
+  WorldModel world;
+  int estimator_calls = 0;
+  LoopMode mode = LoopMode::Lost;
+  std::optional<Eigen::Vector3d> previous_view, previous_target;
+  std::optional<Eigen::Vector3d> last_centroid;  // C of the last frame that found the object
+  std::optional<SeenView> best_seen;  // the view that showed the most of the object
+  std::optional<SeenView> held;       // modes hold, way back, waiting: that view
+  int low_frames = 0;                 // frames in a row showing much less than best_seen or held
+  std::optional<Eigen::Vector3d> target_direction;  // last converged target, unit vector from C
+  int steady_frames = 0;              // frames in a row it stayed near the previous one
+  bool release_when_steady = false;   // the hold began on the way to a target not yet steady
+  bool steadiness_ends_holds = false; // t0 was clear in some frame since steadiness last ended a hold (or since the start)
+  bool t0_was_clear = false;          // t0 was clear in some frame since the start
+};
+
+ViewLoop::ViewLoop(const LoopSettings& settings) : impl_(std::make_unique<Impl>(settings)) {}
+ViewLoop::~ViewLoop() = default;
+ViewLoop::ViewLoop(ViewLoop&&) noexcept = default;
+ViewLoop& ViewLoop::operator=(ViewLoop&&) noexcept = default;
+LoopStep ViewLoop::step(const Observation& observation, double dt) { return impl_->step(observation, dt); }
+void ViewLoop::reset() { impl_->reset(); }
+const LoopSettings& ViewLoop::settings() const { return impl_->settings; }
+const EstimatorSettings& ViewLoop::estimator() const { return impl_->estimator; }
+
+void ViewLoop::Impl::reset() {
+  previous_view.reset();
+  previous_target.reset();
+  controller.reset();
+  safety.reset();
+  world.reset();
+  mode = LoopMode::Lost;
+  best_seen.reset();
+  held.reset();
+  low_frames = 0;
+  target_direction.reset();
+  steady_frames = 0;
+  release_when_steady = false;
+  steadiness_ends_holds = false;
+  t0_was_clear = false;
+  last_centroid.reset();
 }
 
-std::optional<Eigen::Vector3d> ViewLoop::look_ahead(const ViewProblem& problem,
-                                                     const Eigen::Vector3d& c,
-                                                     const std::optional<Eigen::Vector3d>& target, double dt,
-                                                     double frame_age) const {
-  const NoFreeViewSettings& s = settings_.no_free_view;
+ViewEstimate ViewLoop::Impl::estimate_view_counted(const ViewProblem& problem, const EstimatorSettings& s) {
+  ++estimator_calls;
+  return estimate_view(problem, s);
+}
+
+std::optional<ViewEstimate> ViewLoop::Impl::from_previous_target(const ViewProblem& problem) {
+  if (!settings.target_hysteresis || !previous_target) return std::nullopt;
+  ViewProblem from_previous = problem;
+  from_previous.previous_view = *previous_target;
+  EstimatorSettings warm = estimator;
+  warm.warm_start = true;
+  return estimate_view_counted(from_previous, warm);
+}
+
+// The proposers of mode pursue: the frame's estimate, the anticipated
+// estimate, the warm start from the previous target, or a baseline's view.
+Candidate ViewLoop::Impl::pursue(const ViewProblem& problem, LoopStep& out) {
+  const ViewEstimate& estimate = *out.estimate;
+  const ViewProblem* basis = &problem;
+  ViewProblem ahead;
+  std::optional<ViewEstimate> kept;  // from the previous target, on `ahead`
+  if (settings.anticipation.mode == Anticipation::Predict) {
+    const AnticipationSettings& a = settings.anticipation;
+    const Eigen::Matrix3Xd future = world.predicted(a.horizon, a.samples, estimate.centroid, estimator.r_sphere);
+    if (future.cols() > 0) {
+      ahead = problem;
+      ahead.occluders.resize(3, problem.occluders.cols() + future.cols());
+      ahead.occluders << problem.occluders, future;
+      // From the view clear of the occluders as they are now (the spec's
+      // warm start): fewer iterations than from t0 when the future ones
+      // only nudge it. That view stays the target if it is clear of the
+      // predicted occluders too (0 iterations: only whether the start is
+      // clear). Otherwise the warm start from the previous target, if it
+      // is free; only then the search from the frame's view.
+      ahead.previous_view = estimate.tf;
+      EstimatorSettings from_now = estimator;
+      from_now.warm_start = true;
+      from_now.max_iterations = 0;
+      ViewEstimate anticipated = estimate_view_counted(ahead, from_now);
+      if (!is_free(anticipated.status)) {
+        kept = settings.method == ViewMethod::Estimator ? from_previous_target(ahead) : std::nullopt;
+        if (kept && is_free(kept->status)) {
+          anticipated = *kept;
+        } else {
+          from_now.max_iterations = estimator.max_iterations;
+          anticipated = estimate_view_counted(ahead, from_now);
+        }
+      }
+      if (is_free(anticipated.status)) {
+        out.predicted_occluders = future.cols();
+        out.anticipated = std::move(anticipated);
+        basis = &ahead;
+      } else {
+        kept.reset();  // on `ahead`, not on the basis
+      }
+    }
+  }
+  const ViewEstimate& chosen = out.anticipated ? *out.anticipated : estimate;
+  const double r_sphere = estimator.r_sphere;
+  switch (settings.method) {
+    case ViewMethod::Static: return {};
+    case ViewMethod::InitialView: return {chosen.t0, Proposer::InitialView};
+    case ViewMethod::Sampling: {
+      const Eigen::Vector3d best = sample_best_view(*basis, chosen.centroid, r_sphere, settings.sampling).view;
+      if (!settings.target_hysteresis || !previous_target) return {best, Proposer::Sampling};
+      // Keep the previous view while it sees as much as the new best.
+      const Eigen::Vector3d previous = chosen.centroid + r_sphere * (*previous_target - chosen.centroid).normalized();
+      const double rho = settings.sampling.occluder_radius;
+      const bool keep = score_view(*basis, chosen.centroid, r_sphere, previous, rho).visible_fraction >=
+                        score_view(*basis, chosen.centroid, r_sphere, best, rho).visible_fraction;
+      return {keep ? previous : best, Proposer::Sampling};
+    }
+    case ViewMethod::Estimator: break;
+  }
+  if (settings.target_hysteresis && previous_target && chosen.iterations > 0) {
+    // t0 is occluded: continue from the previous target (the spec's warm
+    // start), which stays where it is while clear and otherwise moves to
+    // the nearest clear view. While t0 is clear, t0 is the target.
+    const std::optional<ViewEstimate> warm = kept ? kept : from_previous_target(*basis);
+    if (is_free(warm->status)) return {warm->tf, Proposer::WarmStart};
+  }
+  // Without a free view, the spec's best iterate.
+  return {chosen.tf, out.anticipated ? Proposer::Anticipated : Proposer::Estimate};
+}
+
+// NoFreeViewSettings::look_ahead: the pursuit's view, or when the way there
+// hides more of the object, a nearby view that sees more (most_visible_view)
+// or the camera's own view (hold).
+Candidate ViewLoop::Impl::look_ahead(const Frame& f, const Candidate& pursuit) const {
+  const NoFreeViewSettings& s = settings.no_free_view;
   // Only until t0 has been clear: what hides the object was there from the
   // start and stands still (a cage). What came in since may stand on the
   // way out of the valley the camera is in, where going on beats holding
   // (an arm that stopped over the object; the retreat still acts on a loss).
-  if (!s.look_ahead || !(s.retreat_drop > 0.0) || !target || held_ || t0_was_clear_) return target;
-  const double r = estimator_.r_sphere;
-  const Eigen::Vector3d from = (*problem.camera - c).normalized();
+  if (!s.look_ahead || !pursuit.view || t0_was_clear) return pursuit;
+  const Eigen::Vector3d& c = f.estimate.centroid;
+  const double r = estimator.r_sphere;
+  const Eigen::Vector3d from = (f.here - c).normalized();
   const auto score = [&](const Eigen::Vector3d& direction) {
-    return score_view(problem, c, r, c + r * direction, s.occluder_radius).visible_fraction;
+    return score_view(f.problem, c, r, c + r * direction, s.occluder_radius).visible_fraction;
   };
   const double now = score(from);
   // How far the camera may go before a frame shows the loss and it stops:
   // at the speed limit for the frame's age and one period, then braking.
-  const double v = settings_.safety.max_linear_speed;
-  const double a = settings_.safety.max_linear_accel;
-  const double reach = v * (std::max(frame_age, 0.0) + dt) + v * v / (2.0 * a);
-  const bool steady = steady_frames_ >= kSteadyFrames;
+  const double v = settings.safety.max_linear_speed;
+  const double a = settings.safety.max_linear_accel;
+  const double reach = v * (std::max(f.age, 0.0) + f.dt) + v * v / (2.0 * a);
+  const bool steady = steady_frames >= kSteadyFrames;
   // Whether the way to `goal` (3 points on the great circle, the last at
   // `reach`) loses what the look-ahead counts.
   const auto loses_on_the_way = [&](const Eigen::Vector3d& goal) {
@@ -398,149 +545,173 @@ std::optional<Eigen::Vector3d> ViewLoop::look_ahead(const ViewProblem& problem,
     }
     return worst < (1.0 - s.retreat_drop) * now && (!steady || worst < kSteadyLoss * now);
   };
-  if (!loses_on_the_way(*target)) return target;
+  if (!loses_on_the_way(*pursuit.view)) return pursuit;
   // Climb to a nearby view that sees clearly more, if the way there keeps
   // what the camera sees (holding alone, it would stay wherever it
   // started); else hold.
-  const Eigen::Vector3d climb = most_visible_view(problem, c, r, *problem.camera, {}, s).view;
-  return loses_on_the_way(climb) ? c + r * from : climb;
+  const Eigen::Vector3d climb = most_visible_view(f.problem, c, r, f.here, {}, s).view;
+  if (loses_on_the_way(climb)) return {Eigen::Vector3d(c + r * from), Proposer::Here};
+  return {climb, Proposer::Climb};
 }
 
-std::vector<std::pair<int, Eigen::Vector3d>> ViewLoop::track_positions() const {
-  std::vector<std::pair<int, Eigen::Vector3d>> out;
-  for (const OccluderTrack& t : tracker_.tracks()) out.emplace_back(t.id, t.position);
-  return out;
+void ViewLoop::Impl::transition(Guard guard, LoopStep& out) {
+  const auto t = std::find_if(std::begin(kTransitions), std::end(kTransitions),
+                              [&](const Transition& x) { return x.from == mode && x.guard == guard; });
+  if (t == std::end(kTransitions)) throw std::logic_error(std::string("ViewLoop: no transition from ") +
+                                                          to_string(mode) + " by " + to_string(guard));
+  mode = t->to;
+  out.guard = guard;
 }
 
-Eigen::Matrix3Xd ViewLoop::revealed_still(const SeenView& then) const {
-  // A track that stands still now came there, and was not revealed by the
-  // camera, when it moved farther than this since `then` (or, not tracked
-  // then, since it was first seen), or when it came into view moving (an
-  // arm that arrived and stopped).
-  constexpr double kMovedSince = 0.05;  // [m]
-  std::vector<OccluderTrack> still;
-  for (const OccluderTrack& t : tracker_.tracks()) {
-    if (!is_still(t, settings_.anticipation.min_speed)) continue;
-    const TrackHistory& history = track_history_.at(t.id);
-    const auto was = std::find_if(then.tracks.begin(), then.tracks.end(), [&](const auto& p) { return p.first == t.id; });
-    const Eigen::Vector3d& since = was != then.tracks.end() ? was->second : history.first_position;
-    if (!history.arrived && (t.position - since).norm() <= kMovedSince) still.push_back(t);
+// A steady free view: the estimator converges, frame after frame, to a
+// target within kSteadyDeg of the previous frame's, for kSteadyFrames frames.
+void ViewLoop::Impl::update_steadiness(const Candidate& pursuit, const ViewEstimate& estimate) {
+  if (pursuit.view && estimate.status == ViewStatus::Converged) {
+    const Eigen::Vector3d direction = (*pursuit.view - estimate.centroid).normalized();
+    const bool near = target_direction && direction.dot(*target_direction) >= std::cos(kSteadyDeg * EIGEN_PI / 180.0);
+    steady_frames = near ? steady_frames + 1 : 1;
+    target_direction = direction;
+  } else {
+    steady_frames = 0;
+    target_direction.reset();
   }
-  return still_occluders(still, settings_.anticipation.min_speed);
 }
 
-void ViewLoop::remember_tracks(const std::vector<OccluderTrack>& tracks, double dt) {
-  // Moving within this time of being first seen, a track came into view
-  // moving: it arrived, the camera did not reveal it.
-  constexpr double kArrival = 0.3;  // [s]
-  std::map<int, TrackHistory> history;
-  for (const OccluderTrack& t : tracks) {
-    const auto known = track_history_.find(t.id);
-    TrackHistory h{t.position};
-    if (known != track_history_.end()) {
-      h = known->second;
-      h.age += dt;
+// Guard camera_cost_view (mode pursue), with the evidence it keeps: the view
+// that showed the most in the last kEvidence, and the frames in a row that
+// showed retreat_drop less away from it.
+//
+// A way around an occluder stays where it is, and the camera may lose some
+// of the object on its way there (past the occluder's edge): unless it
+// loses more than half of what it showed (kSteadyLoss), a steady target is
+// no reason to retreat. The loss must come from the camera's own motion:
+// with the occluders as they were when that view showed the most, and those
+// of this frame known to stand still (revealed by the motion), here shows
+// less than there by retreat_drop too; occluders that moved in since cost
+// the object wherever the camera is. And this frame's occluders must make
+// that view clearly better, or at least not worse where they hide most of
+// the object from here.
+bool ViewLoop::Impl::camera_cost_view(const Frame& f, bool steady) {
+  const NoFreeViewSettings& s = settings.no_free_view;
+  constexpr int kFrames = 2;  // a loss counts when it lasts this many frames (one frame is noise)
+  const double keep = 1.0 - s.retreat_drop;
+  if (best_seen) best_seen->age += f.dt;
+  // What a view showed longer ago than kEvidence is no evidence any more
+  // (the occluders move): the current view starts again.
+  if (!best_seen || f.shown >= best_seen->shown || !(best_seen->age <= kEvidence)) {
+    best_seen = seen_here(f);
+    low_frames = 0;
+    return false;
+  }
+  const bool away = (f.here - best_seen->position).norm() > kAway;
+  const bool less = f.shown < keep * best_seen->shown && (!steady || f.shown < kSteadyLoss * best_seen->shown);
+  low_frames = away && less ? low_frames + 1 : 0;
+  if (low_frames < kFrames) return false;
+  const Eigen::Vector3d& c = f.estimate.centroid;
+  const double r = estimator.r_sphere;
+  const auto score = [&](const ViewProblem& scene, const Eigen::Vector3d& p) {
+    return score_view(scene, c, r, c + r * (p - c).normalized(), s.occluder_radius).visible_fraction;
+  };
+  const Eigen::Matrix3Xd still = world.revealed_still(best_seen->tracks);
+  ViewProblem then = f.problem;
+  then.occluders.resize(3, best_seen->occluders.cols() + still.cols());
+  then.occluders << best_seen->occluders, still;
+  if (!(score(then, f.here) < keep * score(then, best_seen->position))) return false;
+  const double here_score = score(f.problem, f.here);
+  const double margin = here_score < 0.5 ? 0.0 : 0.1;
+  return !(score(f.problem, best_seen->position) < here_score + margin);  // else the occluders came there too
+}
+
+// The mode machine in a frame that found the object (the retreat on).
+void ViewLoop::Impl::found(const Frame& f, LoopStep& out) {
+  const NoFreeViewSettings& s = settings.no_free_view;
+  constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
+  const double keep = 1.0 - s.retreat_drop;
+  const bool steady = steady_frames >= kSteadyFrames;
+  if (f.estimate.iterations == 0) steadiness_ends_holds = t0_was_clear = true;
+  if (mode == LoopMode::WayBack || mode == LoopMode::Waiting || mode == LoopMode::Lost) {
+    transition(Guard::ObjectFound, out);
+  }
+  if (mode == LoopMode::Hold) {
+    const bool there = (f.here - held->position).norm() <= kAway;
+    low_frames = there && f.shown < keep * held->shown ? low_frames + 1 : 0;
+    Guard release = Guard::None;
+    if (f.estimate.iterations == 0) {
+      release = Guard::T0Clear;
+    } else if (low_frames >= kReleaseFrames) {
+      release = Guard::SceneChanged;
+    } else if (steady && release_when_steady) {
+      // A hold that began while the target was not yet steady (an occluder
+      // arriving) ends when it is; from then on, steadiness ends no hold
+      // until t0 has been clear again (a steady view failed: in a still
+      // cage the false gaps are steady too).
+      release = Guard::TargetSteady;
+      steadiness_ends_holds = false;
     }
-    h.arrived = h.arrived || (h.age <= kArrival && is_moving(t, settings_.anticipation.min_speed));
-    history.emplace(t.id, h);
+    if (release == Guard::None) return;
+    transition(release, out);
+    held.reset();
+    best_seen = seen_here(f);
+    low_frames = 0;
+    return;
   }
-  track_history_ = std::move(history);
-}
-
-std::optional<Eigen::Vector3d> ViewLoop::way_back(const Eigen::Vector3d& here, double dt) {
-  if (settings_.no_free_view.retreat_drop <= 0.0 || !last_centroid_) return std::nullopt;
-  if (!held_) {
-    if (!best_seen_) return std::nullopt;
-    best_seen_->age += dt;
-    if (!(best_seen_->age <= kEvidence)) return std::nullopt;  // not lost by the camera's recent motion
-    held_ = best_seen_;
-    release_when_steady_ = false;
-    low_frames_ = 0;
+  if (camera_cost_view(f, steady)) {
+    transition(Guard::CameraCostView, out);
+    held = best_seen;
+    // Steadiness ends this hold only if it began on the way to a target not
+    // yet steady, and t0 has been clear since steadiness last ended one.
+    release_when_steady = !steady && steadiness_ends_holds;
+    low_frames = 0;
   }
-  if ((here - held_->position).norm() <= kAway) return std::nullopt;  // back there: wait for perception
-  return held_->position;
 }
 
-std::optional<ViewEstimate> ViewLoop::from_previous_target(const ViewProblem& problem) const {
-  if (!settings_.target_hysteresis || !previous_target_) return std::nullopt;
-  ViewProblem from_previous = problem;
-  from_previous.previous_view = *previous_target_;
-  EstimatorSettings warm = estimator_;
-  warm.warm_start = true;
-  return estimate_view(from_previous, warm);
-}
-
-std::optional<Eigen::Vector3d> ViewLoop::choose_target(const ViewProblem& problem, const ViewEstimate& estimate,
-                                                       const std::optional<ViewEstimate>& kept) {
-  const double r_sphere = estimator_.r_sphere;
-  switch (settings_.method) {
-    case ViewMethod::Static: return std::nullopt;
-    case ViewMethod::InitialView: return estimate.t0;
-    case ViewMethod::Sampling: {
-      const Eigen::Vector3d best = sample_best_view(problem, estimate.centroid, r_sphere, settings_.sampling).view;
-      if (!settings_.target_hysteresis || !previous_target_) return best;
-      // Keep the previous view while it sees as much as the new best.
-      const Eigen::Vector3d previous = estimate.centroid + r_sphere * (*previous_target_ - estimate.centroid).normalized();
-      const double rho = settings_.sampling.occluder_radius;
-      return score_view(problem, estimate.centroid, r_sphere, previous, rho).visible_fraction >=
-                     score_view(problem, estimate.centroid, r_sphere, best, rho).visible_fraction
-                 ? previous
-                 : best;
+// The mode machine in a frame without the object (the retreat on).
+void ViewLoop::Impl::lost(const Eigen::Vector3d& here, double dt, LoopStep& out) {
+  if (mode == LoopMode::Pursue || mode == LoopMode::Lost) {
+    if (best_seen) best_seen->age += dt;
+    if (mode == LoopMode::Pursue) {
+      if (best_seen && best_seen->age <= kEvidence) {
+        transition(Guard::ObjectLost, out);
+        held = best_seen;
+        release_when_steady = false;
+        low_frames = 0;
+      } else {
+        transition(Guard::ObjectLostNoView, out);
+      }
     }
-    case ViewMethod::Estimator: break;
+  } else if (mode == LoopMode::Hold) {
+    transition(Guard::ObjectLost, out);
   }
-  if (settings_.target_hysteresis && previous_target_ && estimate.iterations > 0) {
-    // t0 is occluded: continue from the previous target (the spec's warm
-    // start), which stays where it is while clear and otherwise moves to
-    // the nearest clear view. While t0 is clear, t0 is the target.
-    const std::optional<ViewEstimate> warm = kept ? kept : from_previous_target(problem);
-    if (is_free(warm->status)) return warm->tf;
-  }
-  // Without a free view, the spec's best iterate.
-  return estimate.tf;
+  const bool there = held && (here - held->position).norm() <= kAway;
+  if (mode == LoopMode::WayBack && there) transition(Guard::BackThere, out);
+  if (mode == LoopMode::Waiting && !there) transition(Guard::AwayAgain, out);
 }
 
-Eigen::Matrix3Xd ViewLoop::predicted(const Eigen::Vector3d& centroid) const {
-  const AnticipationSettings& a = settings_.anticipation;
-  std::vector<double> times;
-  for (int k = 1; k <= a.samples; ++k) times.push_back(a.horizon * k / a.samples);
-  const Eigen::Matrix3Xd all = predicted_occluders(tracker_.tracks(), times, a.min_speed);
-  // Only the copies inside the sphere are occluders (spec §3).
-  std::vector<Eigen::Index> inside;
-  for (Eigen::Index i = 0; i < all.cols(); ++i) {
-    if ((all.col(i) - centroid).norm() < estimator_.r_sphere) inside.push_back(i);
-  }
-  return all(Eigen::all, inside);
-}
-
-LoopStep ViewLoop::step(const Observation& observation, double dt) {
+LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
   LoopStep out;
+  estimator_calls = 0;
   reserve_estimator_memory(kReservedOcclusionPoints);  // once per thread
   auto start = Clock::now();
   const vpHomogeneousMatrix wMc = to_visp(observation.wMc);
-  const double frame_age = observation.age;
+  const Eigen::Vector3d here = observation.wMc.translation();
   // The estimator avoids the occluders seen and those presumed (last).
   std::optional<ViewProblem> problem = observation.problem;
   const Eigen::Index seen = problem ? problem->occluders.cols() : 0;
   if (problem) {
     if (observation.presumed.cols() > 0) problem->occluders = observation.all_occluders();
-    problem->camera = observation.wMc.translation();
-    problem->previous_view = previous_view_;
-    out.estimate = estimate_view(*problem, estimator_);
+    problem->camera = here;
+    problem->previous_view = previous_view;
+    out.estimate = estimate_view_counted(*problem, estimator);
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
-  }
-  const bool timed = std::isfinite(dt) && dt > 0.0;
-  if (!timed) {  // no time base: start the tracks again
-    tracker_.reset();
-    track_history_.clear();
-  }
-  if (problem) {
     out.presumed_occluders = problem->occluders.cols() - seen;
-    out.tracks = tracker_.update(problem->occluders.leftCols(seen), dt);
-  } else {
-    out.tracks = tracker_.coast(dt);
   }
-  remember_tracks(out.tracks, timed ? dt : 0.0);
+  // The world model, once per frame: the tracks of the occluders seen.
+  const Eigen::Matrix3Xd seen_occluders = problem ? Eigen::Matrix3Xd(problem->occluders.leftCols(seen)) : Eigen::Matrix3Xd();
+  out.tracks = world.update(problem ? &seen_occluders : nullptr, dt);
+
+  // The retreat's mode machine runs with the estimator, a known shown area and retreat_drop > 0.
+  const bool retreat = settings.method == ViewMethod::Estimator && settings.no_free_view.retreat_drop > 0.0;
+  Candidate selected;
   if (out.estimate) {
     switch (out.estimate->status) {
       case ViewStatus::Converged: out.status = StepStatus::Converged; break;
@@ -548,66 +719,41 @@ LoopStep ViewLoop::step(const Observation& observation, double dt) {
       case ViewStatus::OutOfTime: out.status = StepStatus::NotConverged; break;
       default: out.status = StepStatus::NoOccluders; break;
     }
-    const ViewProblem* basis = &*problem;
-    ViewProblem ahead;
-    std::optional<ViewEstimate> kept;  // from the previous target, on `ahead`
-    if (settings_.anticipation.mode == Anticipation::Predict) {
-      const Eigen::Matrix3Xd future = predicted(out.estimate->centroid);
-      if (future.cols() > 0) {
-        ahead = *problem;
-        ahead.occluders.resize(3, problem->occluders.cols() + future.cols());
-        ahead.occluders << problem->occluders, future;
-        // From the view clear of the occluders as they are now (the spec's
-        // warm start): fewer iterations than from t0 when the future ones
-        // only nudge it.
-        ahead.previous_view = out.estimate->tf;
-        EstimatorSettings from_now = estimator_;
-        from_now.warm_start = true;
-        // That view stays the target if it is clear of the predicted
-        // occluders too (0 iterations: only whether the start is clear).
-        // Otherwise choose_target continues from the previous target and
-        // takes that if it is free: estimated first here, so that the
-        // search from the frame's view runs only when it is not.
-        from_now.max_iterations = 0;
-        ViewEstimate anticipated = estimate_view(ahead, from_now);
-        if (!is_free(anticipated.status)) {
-          kept = settings_.method == ViewMethod::Estimator ? from_previous_target(ahead) : std::nullopt;
-          if (kept && is_free(kept->status)) {
-            anticipated = *kept;
-          } else {
-            from_now.max_iterations = estimator_.max_iterations;
-            anticipated = estimate_view(ahead, from_now);
-          }
-        }
-        if (is_free(anticipated.status)) {
-          out.predicted_occluders = future.cols();
-          out.anticipated = std::move(anticipated);
-          basis = &ahead;
-        } else {
-          kept.reset();  // on `ahead`, not on the basis
-        }
-      }
+    const Candidate pursuit = pursue(*problem, out);
+    selected = pursuit;
+    if (retreat && observation.shown_area) {
+      const Frame f{*problem, seen, *out.estimate, here, *observation.shown_area, dt, observation.age};
+      update_steadiness(pursuit, *out.estimate);
+      found(f, out);
+      if (mode == LoopMode::Pursue) selected = look_ahead(f, pursuit);
+      if (mode == LoopMode::Hold) selected = {held->position, Proposer::BestSeen};
+    } else {
+      if (mode != LoopMode::Pursue) out.guard = Guard::ObjectFound;
+      mode = LoopMode::Pursue;
     }
-    out.target = choose_target(*basis, out.anticipated ? *out.anticipated : *out.estimate, kept);
-    if (settings_.method == ViewMethod::Estimator && observation.shown_area) {
-      out.target = retreat(*problem, seen, *out.estimate, *observation.shown_area, dt, out.target);
-      out.target = look_ahead(*problem, out.estimate->centroid, out.target, dt, frame_age);
-    }
-    previous_view_ = out.estimate->tf;
-    previous_target_ = out.target;
-    last_centroid_ = out.estimate->centroid;
-  } else if (settings_.method == ViewMethod::Estimator) {
-    out.target = way_back(observation.wMc.translation(), dt);
+    previous_view = out.estimate->tf;
+    previous_target = selected.view;
+    last_centroid = out.estimate->centroid;
+  } else if (retreat && last_centroid) {
+    lost(here, dt, out);
+    if (mode == LoopMode::WayBack) selected = {held->position, Proposer::BestSeen};
+  } else {
+    if (mode != LoopMode::Lost) out.guard = Guard::ObjectLostNoView;
+    mode = LoopMode::Lost;
   }
+  out.mode = mode;
+  out.target = selected.view;
+  out.proposer = selected.by;
+  out.estimator_calls = estimator_calls;
   out.estimate_s = seconds_since(start);
 
   start = Clock::now();
   if (out.target) {
-    out.command = controller_.update(*out.target, *last_centroid_, estimator_.r_sphere, wMc, dt);
+    out.command = controller.update(*out.target, *last_centroid, estimator.r_sphere, wMc, dt);
   }
-  // Lost, the camera moves only on its way back (way_back).
-  out.velocity = safety_.filter(out.command, wMc, dt, out.estimate.has_value() || out.target.has_value(), frame_age);
-  out.safety = safety_.last_action();
+  // Lost, the camera moves only on its way back.
+  out.velocity = safety.filter(out.command, wMc, dt, out.estimate.has_value() || out.target.has_value(), observation.age);
+  out.safety = safety.last_action();
   out.control_s = seconds_since(start);
   return out;
 }

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+
 namespace ofv {
 namespace {
 
@@ -148,9 +150,29 @@ TEST(Metrics, PerceptionScoresSummariseOverTheFramesThatHaveThem) {
   EXPECT_EQ(back.perception.lost_half_visible, 1);
   EXPECT_TRUE(metrics_to_json(summarise(episode({1.0}, {0})))["perception"].is_null());
 
-  // trajectory.csv: the scores last, empty where there is none.
-  const std::string row = trajectory_csv_row(steps[3]);
-  EXPECT_EQ(row.substr(row.size() - 7), ",,0,,,,");
+  // trajectory.csv: the scores by name, empty where there is none.
+  const auto fields = [](const std::string& line) {
+    std::vector<std::string> out(1);
+    for (const char c : line) {
+      if (c == ',') {
+        out.emplace_back();
+      } else {
+        out.back().push_back(c);
+      }
+    }
+    return out;
+  };
+  const std::vector<std::string> header = fields(trajectory_csv_header()), row = fields(trajectory_csv_row(steps[3]));
+  ASSERT_EQ(header.size(), row.size());
+  std::map<std::string, std::string> value;
+  for (std::size_t i = 0; i < header.size(); ++i) value[header[i]] = row[i];
+  EXPECT_EQ(value["object_precision"], "");
+  EXPECT_EQ(value["object_recall"], "0");
+  for (const char* empty : {"occluder_precision", "occluder_recall", "centroid_error", "hidden_error"}) {
+    EXPECT_EQ(value[empty], "") << empty;
+  }
+  EXPECT_EQ(value["mode"], "lost");
+  EXPECT_EQ(value["proposer"], "none");
 }
 
 }  // namespace

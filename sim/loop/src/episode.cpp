@@ -150,6 +150,10 @@ void record_step(StepRecord& rec, const LoopStep& step) {
     rec.fastest_track_speed = std::max(rec.fastest_track_speed, t.velocity.norm());
   }
   rec.predicted_occluders = static_cast<int>(step.predicted_occluders);
+  rec.mode = step.mode;
+  rec.guard = step.guard;
+  rec.proposer = step.proposer;
+  rec.estimator_calls = step.estimator_calls;
   for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = step.velocity[i];
 }
 

@@ -38,7 +38,7 @@ cv::Mat camera_picture(const StepRecord& rec, const StepDetail& d) {
   }
   std::ostringstream text;
   text << std::fixed << std::setprecision(2) << "t=" << rec.time << "s  visible " << rec.visible_fraction
-       << "  " << to_string(rec.status);
+       << "  " << to_string(rec.status) << "  " << to_string(rec.mode) << " (" << to_string(rec.proposer) << ")";
   cv::putText(img, text.str(), {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {255, 255, 255}, 1, cv::LINE_AA);
   return img;
 }

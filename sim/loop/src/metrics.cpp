@@ -76,7 +76,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
   double visible = 0.0;
   double error = 0.0;
   m.min_visible_fraction = steps.front().visible_fraction;
-  std::map<std::string, int> statuses;
+  std::map<std::string, int> statuses, modes;
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const StepRecord& s = steps[k];
     total += dt[k];
@@ -97,7 +97,10 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
     m.max_times.estimate = std::max(m.max_times.estimate, s.times.estimate);
     m.max_times.control = std::max(m.max_times.control, s.times.control);
     m.estimator_iterations_max = std::max(m.estimator_iterations_max, s.iterations);
+    m.estimator_calls_mean += s.estimator_calls;
+    m.estimator_calls_max = std::max(m.estimator_calls_max, s.estimator_calls);
     ++statuses[to_string(s.status)];
+    ++modes[to_string(s.mode)];
   }
   m.duration = total;
   // Time-weighted means; a single step (no duration) weighs as one sample.
@@ -114,7 +117,9 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
   m.mean_times.perception /= n;
   m.mean_times.estimate /= n;
   m.mean_times.control /= n;
+  m.estimator_calls_mean /= n;
   m.status_counts.assign(statuses.begin(), statuses.end());
+  m.mode_counts.assign(modes.begin(), modes.end());
 
   // When a count last rose, at or before each step.
   const auto last_rise = [&steps](int StepRecord::*count) {
@@ -229,7 +234,8 @@ std::string trajectory_csv_header() {
          "visible_fraction,angular_error_deg,sphere_distance_error,occluders_in_sphere,occluders_in_view,tracks,fastest_track_speed,"
          "predicted_occluders,"
          "render_s,perception_s,estimate_s,control_s,"
-         "object_precision,object_recall,occluder_precision,occluder_recall,centroid_error,hidden_error";
+         "object_precision,object_recall,occluder_precision,occluder_recall,centroid_error,hidden_error,"
+         "mode,guard,proposer,estimator_calls";
 }
 
 std::string trajectory_csv_row(const StepRecord& s) {
@@ -260,6 +266,8 @@ std::string trajectory_csv_row(const StepRecord& s) {
     out << ',';
     if (s.perception.*score) out << *(s.perception.*score);
   }
+  out << ',' << to_string(s.mode) << ',' << to_string(s.guard) << ',' << to_string(s.proposer) << ','
+      << s.estimator_calls;
   return out.str();
 }
 

@@ -91,6 +91,8 @@ json metrics_to_json(const EpisodeMetrics& m) {
   }
   json statuses = json::object();
   for (const auto& [status, count] : m.status_counts) statuses[status] = count;
+  json modes = json::object();
+  for (const auto& [mode, count] : m.mode_counts) modes[mode] = count;
   return {{"steps", m.steps},
           {"duration_s", m.duration},
           {"visibility_threshold", m.visibility_threshold},
@@ -108,7 +110,10 @@ json metrics_to_json(const EpisodeMetrics& m) {
           {"mean_compute_time", times_to_json(m.mean_times)},
           {"max_compute_time", times_to_json(m.max_times)},
           {"estimator_iterations_max", m.estimator_iterations_max},
+          {"estimator_calls_mean", m.estimator_calls_mean},
+          {"estimator_calls_max", m.estimator_calls_max},
           {"status_counts", statuses},
+          {"mode_counts", modes},
           {"perception", perception_to_json(m.perception)}};
 }
 
@@ -138,6 +143,10 @@ EpisodeMetrics metrics_from_json(const json& j) {
   m.mean_times = times_from_json(j.at("mean_compute_time"));
   m.max_times = times_from_json(j.at("max_compute_time"));
   m.estimator_iterations_max = j.at("estimator_iterations_max").get<int>();
+  m.estimator_calls_mean = j.value("estimator_calls_mean", 0.0);
+  m.estimator_calls_max = j.value("estimator_calls_max", 0);
+  const json modes = j.value("mode_counts", json::object());
+  for (const auto& [mode, count] : modes.items()) m.mode_counts.emplace_back(mode, count.get<int>());
   for (const auto& [status, count] : j.at("status_counts").items()) {
     m.status_counts.emplace_back(status, count.get<int>());
   }

@@ -97,6 +97,7 @@ RgbPicture scene_picture(const SceneState& s, const std::vector<Eigen::Vector3d>
   text << std::fixed << std::setprecision(2) << "t=" << s.time << " s   ";
   if (s.visible_fraction) text << "visible " << *s.visible_fraction << "   ";
   if (s.status) text << "status " << to_string(*s.status);
+  if (s.step) text << "   " << to_string(s.step->mode) << " (" << to_string(s.step->proposer) << ")";
   cv::putText(img, text.str(), {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {255, 255, 255}, 1,
               cv::LINE_AA);
 

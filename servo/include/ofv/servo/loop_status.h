@@ -1,7 +1,7 @@
 /**
  * \file loop_status.h
- * \brief What the loop and its safety filter did with a frame (no ViSP
- *        types, so records and metrics can carry them).
+ * \brief What the loop, its mode machine and its safety filter did with a
+ *        frame (no ViSP types, so records and metrics can carry them).
  */
 #pragma once
 
@@ -31,5 +31,54 @@ enum class SafetyAction {
 [[nodiscard]] const char* to_string(SafetyAction action);
 /// \brief True for the actions that stop the robot.
 [[nodiscard]] bool stops(SafetyAction action);
+
+/**
+ * \brief The loop's mode after a frame: the state of ViewLoop's mode machine.
+ *
+ * Pursue drives to the view the proposers give; Hold keeps the view that
+ * showed the most of the object in the last 0.5 s (the retreat); WayBack
+ * drives back there when the object is lost; Waiting is back there with the
+ * object still lost; Lost stops with no view to go back to.
+ */
+enum class LoopMode {
+  Pursue,   ///< to the selected view (estimate, anticipated, warm start, look-ahead)
+  Hold,     ///< at the view that showed the most, until a guard releases it
+  WayBack,  ///< the object lost: back to that view
+  Waiting,  ///< the object lost, back at that view: stopped, perception looks for it there
+  Lost,     ///< the object lost with no recent view to go back to: stopped
+};
+/// \brief The word in files and on the terminal: pursue, hold, way_back, waiting, lost.
+[[nodiscard]] const char* to_string(LoopMode mode);
+
+/// \brief The guard of the mode machine that moved the loop in a frame.
+enum class Guard {
+  None,            ///< no transition
+  CameraCostView,  ///< pursue → hold: the camera's own motion cost retreat_drop of what that view showed
+  T0Clear,         ///< hold → pursue: t0 is clear
+  SceneChanged,    ///< hold → pursue: back there, it keeps showing retreat_drop less (the scene changed)
+  TargetSteady,    ///< hold → pursue: the target the hold interrupted on its way became steady
+  ObjectLost,      ///< pursue | hold → way back: the object lost within 0.5 s of that view, or while holding
+  ObjectLostNoView,  ///< pursue → lost: the object lost with no such view
+  BackThere,       ///< way back → waiting
+  AwayAgain,       ///< waiting → way back
+  ObjectFound,     ///< way back | waiting → hold; lost → pursue (then that mode's guards, the same frame)
+};
+/// \brief The word in files and on the terminal, e.g. camera_cost_view, t0_clear.
+[[nodiscard]] const char* to_string(Guard guard);
+
+/// \brief Which proposer's view the controller drives to.
+enum class Proposer {
+  None,         ///< no target: the camera stops (object lost, method static, back there)
+  Estimate,     ///< the frame's estimate: t_f (t0 when clear)
+  Anticipated,  ///< the estimate against the occluders' predicted positions too (anticipation=predict)
+  WarmStart,    ///< continued from the previous target while t0 is occluded (target_hysteresis)
+  Climb,        ///< look-ahead: a nearby view that sees clearly more (most_visible_view)
+  Here,         ///< look-ahead: the camera's own view (it holds where it is)
+  BestSeen,     ///< the view that showed the most of the object (modes hold and way back)
+  InitialView,  ///< baseline method initial_view: t0
+  Sampling,     ///< baseline method sampling
+};
+/// \brief The word in files and on the terminal, e.g. estimate, warm_start.
+[[nodiscard]] const char* to_string(Proposer proposer);
 
 }  // namespace ofv

@@ -37,7 +37,7 @@
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
-#include <map>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -108,6 +108,9 @@ struct LoopStep {
   StepStatus status = StepStatus::ObjectLost;  ///< what the frame came to
   std::optional<ViewEstimate> estimate;   ///< the estimator's result (none when the object is lost)
   std::optional<Eigen::Vector3d> target;  ///< the view the controller drives to (none: hold still)
+  LoopMode mode = LoopMode::Lost;         ///< the mode after this frame
+  Guard guard = Guard::None;              ///< the last transition this frame took, if any
+  Proposer proposer = Proposer::None;     ///< whose view the target is
   vpColVector command = vpColVector(6, 0.0);   ///< the controller's twist [m/s, rad/s]
   vpColVector velocity = vpColVector(6, 0.0);  ///< after the safety filter: send this to the robot
   SafetyAction safety = SafetyAction::None;    ///< what the safety filter did
@@ -121,19 +124,35 @@ struct LoopStep {
   Eigen::Index predicted_occluders = 0;  ///< predicted points added to the problem
   /// Occluders presumed, not seen (Observation::presumed).
   Eigen::Index presumed_occluders = 0;
+  int estimator_calls = 0;  ///< estimate_view calls this frame
   double estimate_s = 0.0;  ///< compute time of view selection [s]
   double control_s = 0.0;   ///< compute time of controller and filter [s]
 };
 
 /**
  * \brief The per-frame policy. One instance per episode or run: it keeps
- *        the previous view and target, the controller's filter and the
- *        safety filter's previous command.
+ *        the world model (occluder tracks), the mode machine's state, the
+ *        previous view and target, the controller's task and the safety
+ *        filter's previous command.
+ *
+ * Each frame, in order (docs/architecture.md, "The per-frame policy"):
+ * the world model is updated with the occluders seen; the proposers give
+ * candidate views (the estimate, the anticipated one, the warm start from
+ * the previous target, the look-ahead's climb or hold, the best view seen);
+ * the mode machine moves by its named guards (ofv::Guard: one transition a
+ * frame, after the object was found or lost again one more); the
+ * selector picks the mode's view; the controller and the safety filter
+ * turn it into a twist. Movable, not copyable.
  */
 class ViewLoop {
  public:
   /// \throws std::invalid_argument naming a setting out of range.
   explicit ViewLoop(const LoopSettings& settings);
+  ~ViewLoop();
+  ViewLoop(ViewLoop&&) noexcept;             ///< moves the loop and its state
+  ViewLoop& operator=(ViewLoop&&) noexcept;  ///< moves the loop and its state
+  ViewLoop(const ViewLoop&) = delete;
+  ViewLoop& operator=(const ViewLoop&) = delete;
 
   /**
    * \param observation what the frame shows (ofv::Observer): the problem
@@ -153,74 +172,13 @@ class ViewLoop {
   void reset();
 
   /// \brief The settings it was made with.
-  [[nodiscard]] const LoopSettings& settings() const { return settings_; }
+  [[nodiscard]] const LoopSettings& settings() const;
   /// \brief The resolved estimator settings (preset applied).
-  [[nodiscard]] const EstimatorSettings& estimator() const { return estimator_; }
+  [[nodiscard]] const EstimatorSettings& estimator() const;
 
  private:
-  /// `kept`: the warm start from the previous target on `problem`, when
-  /// already estimated (it is then not estimated again).
-  [[nodiscard]] std::optional<Eigen::Vector3d> choose_target(const ViewProblem& problem, const ViewEstimate& estimate,
-                                                             const std::optional<ViewEstimate>& kept = std::nullopt);
-  [[nodiscard]] std::optional<ViewEstimate> from_previous_target(const ViewProblem& problem) const;
-  /// The object lost within kEvidence of the view that showed the most (or
-  /// while holding one): that view, until the camera is back there.
-  [[nodiscard]] std::optional<Eigen::Vector3d> way_back(const Eigen::Vector3d& here, double dt);
-  [[nodiscard]] Eigen::Matrix3Xd predicted(const Eigen::Vector3d& centroid) const;
-  /// `seen`: the problem's first `seen` occluders were seen (the rest
-  /// presumed); only those are evidence of what a view showed.
-  [[nodiscard]] std::optional<Eigen::Vector3d> retreat(const ViewProblem& problem, Eigen::Index seen,
-                                                       const ViewEstimate& estimate, double shown, double dt,
-                                                       const std::optional<Eigen::Vector3d>& target);
-
-  /// A camera position (world), how much of the object it showed, the
-  /// occluders seen in that frame, how long ago that was and where the
-  /// occluder tracks were.
-  struct SeenView {
-    Eigen::Vector3d position;
-    double shown = 0.0;
-    Eigen::Matrix3Xd occluders;
-    double age = 0.0;  ///< time since [s]
-    std::vector<std::pair<int, Eigen::Vector3d>> tracks;  ///< each track's id and position then
-  };
-  /// NoFreeViewSettings::look_ahead: `target`, or when the way there hides
-  /// more of the object, a nearby view that sees more (most_visible_view)
-  /// or the camera's own view (hold).
-  [[nodiscard]] std::optional<Eigen::Vector3d> look_ahead(const ViewProblem& problem,
-                                                          const Eigen::Vector3d& c,
-                                                          const std::optional<Eigen::Vector3d>& target, double dt,
-                                                          double frame_age) const;
-  [[nodiscard]] std::vector<std::pair<int, Eigen::Vector3d>> track_positions() const;
-  /// What the loop keeps of an occluder track since it was first seen.
-  struct TrackHistory {
-    Eigen::Vector3d first_position;
-    double age = 0.0;      ///< time since first seen [s]
-    bool arrived = false;  ///< it moved soon after it was first seen: it came into view moving
-  };
-  /// Updates track_history_ with this frame's tracks.
-  void remember_tracks(const std::vector<OccluderTrack>& tracks, double dt);
-  /// This frame's points of the tracks that stand still, did not arrive
-  /// moving, and stood where they are when `then` was seen (or, not
-  /// tracked then, where they were first seen): what the camera's motion
-  /// may have revealed.
-  [[nodiscard]] Eigen::Matrix3Xd revealed_still(const SeenView& then) const;
-
-  LoopSettings settings_;
-  EstimatorSettings estimator_;
-  ViewController controller_;
-  SafetyFilter safety_;
-  OccluderTracker tracker_;
-  std::optional<Eigen::Vector3d> previous_view_, previous_target_;
-  std::optional<Eigen::Vector3d> last_centroid_;  ///< C of the last frame that found the object
-  std::optional<SeenView> best_seen_;  ///< the view that showed the most of the object
-  std::optional<SeenView> held_;       ///< retreated there: hold
-  int low_frames_ = 0;                 ///< frames in a row showing much less than best_seen_ or held_
-  std::optional<Eigen::Vector3d> target_direction_;  ///< last converged target, unit vector from C
-  int steady_frames_ = 0;              ///< frames in a row it stayed near the previous one
-  bool release_when_steady_ = false;   ///< the hold began on the way to a target not yet steady
-  bool steadiness_ends_holds_ = false; ///< t0 was clear in some frame since steadiness last ended a hold (or since the start)
-  bool t0_was_clear_ = false;          ///< t0 was clear in some frame since the start
-  std::map<int, TrackHistory> track_history_;  ///< of each current occluder track, by id
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace ofv

@@ -50,6 +50,10 @@ struct StepRecord {
   int tracks = 0;                     ///< confirmed occluder tracks seen this frame
   double fastest_track_speed = 0.0;   ///< largest speed among them [m/s]
   int predicted_occluders = 0;        ///< predicted occluder points the target was chosen against
+  LoopMode mode = LoopMode::Lost;     ///< the loop's mode after the frame (LoopStep::mode)
+  Guard guard = Guard::None;          ///< the mode machine's transition in the frame, if any
+  Proposer proposer = Proposer::None; ///< whose view the target is
+  int estimator_calls = 0;            ///< estimate_view calls of the frame
   /// The front end's output against the frame's labels (ofv/perception/scores.h);
   /// all empty when the estimator's input is the simulator's ground truth.
   PerceptionScores perception;
@@ -120,7 +124,10 @@ struct EpisodeMetrics {
   StageTimes mean_times;                ///< mean compute time per stage [s]
   StageTimes max_times;                 ///< worst step per stage [s]
   int estimator_iterations_max = 0;     ///< most push steps of one estimate
+  double estimator_calls_mean = 0.0;    ///< estimate_view calls per frame, mean
+  int estimator_calls_max = 0;          ///< estimate_view calls of the busiest frame
   std::vector<std::pair<std::string, int>> status_counts;  ///< steps per status
+  std::vector<std::pair<std::string, int>> mode_counts;    ///< steps per loop mode (LoopMode)
   PerceptionSummary perception;  ///< empty (scored() false) with ground-truth perception
 };
 

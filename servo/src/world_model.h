@@ -1,0 +1,54 @@
+// The loop's world model (internal to ofv::servo): the occluder tracks and
+// what the loop keeps of each since it was first seen, updated once per frame.
+#pragma once
+
+#include "ofv/occluder_tracker.h"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace ofv {
+
+/// Each track's id and position at some frame.
+using TrackPositions = std::vector<std::pair<int, Eigen::Vector3d>>;
+
+class WorldModel {
+ public:
+  /// `min_speed`: tracks slower than this stand still (AnticipationSettings::min_speed).
+  WorldModel(const TrackerSettings& tracker, double min_speed) : tracker_(tracker), min_speed_(min_speed) {}
+
+  /// The frame's seen occluders (none: the object lost, the tracks coast).
+  /// A period that is not finite and positive starts the tracks again.
+  const std::vector<OccluderTrack>& update(const Eigen::Matrix3Xd* seen, double dt);
+  void reset();
+
+  [[nodiscard]] const std::vector<OccluderTrack>& tracks() const { return tracker_.tracks(); }
+  [[nodiscard]] TrackPositions positions() const;
+  /// Copies of the moving tracks' points where their velocity takes them
+  /// after horizon x k / samples, k = 1..samples, kept inside the sphere.
+  [[nodiscard]] Eigen::Matrix3Xd predicted(double horizon, int samples, const Eigen::Vector3d& centroid,
+                                           double r_sphere) const;
+  /// This frame's points of the tracks that stand still, did not come into
+  /// view moving, and stood where they are when `then` was recorded (or, not
+  /// tracked then, where they were first seen): what the camera's own motion
+  /// may have revealed since.
+  [[nodiscard]] Eigen::Matrix3Xd revealed_still(const TrackPositions& then) const;
+
+ private:
+  /// What the loop keeps of a track since it was first seen.
+  struct History {
+    Eigen::Vector3d first_position;
+    double age = 0.0;      // time since first seen [s]
+    bool arrived = false;  // it moved soon after it was first seen: it came into view moving
+  };
+  void remember(double dt);
+
+  OccluderTracker tracker_;
+  double min_speed_;
+  std::map<int, History> history_;  // of each current track, by id
+};
+
+}  // namespace ofv
