@@ -131,7 +131,7 @@ ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& c
 
 ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
                              const Eigen::Vector3d& current, const std::vector<Eigen::Vector3d>& others,
-                             const NoFreeViewSettings& settings) {
+                             const MostVisibleSettings& settings) {
   const UsableInput u = usable_input(problem, centroid, r_sphere);
   const auto on_sphere = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
     const Eigen::Vector3d d = p - centroid;

@@ -33,7 +33,7 @@ struct Observation {
   Eigen::Matrix3Xd presumed = Eigen::Matrix3Xd(3, 0);
   /// How much of the object's surface the frame shows [m²]: its voxels seen
   /// in the frame times a voxel's face; std::nullopt when unknown (then the
-  /// loop never retreats, NoFreeViewSettings::retreat_drop).
+  /// loop never retreats, RetreatSettings::drop).
   std::optional<double> shown_area;
   /// Pose of the camera that took the frame (world ← camera).
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();

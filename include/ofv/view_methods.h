@@ -83,55 +83,14 @@ struct ScoredView {
                                           const SamplingSettings& sampling);
 
 /// \brief Settings of most_visible_view().
-struct NoFreeViewSettings {
+struct MostVisibleSettings {
   double step_deg = 8.0;          ///< neighbours of the current view, this far from it seen from C [deg]
   double margin = 0.05;           ///< a view must see this much more of the object than the current one
   double occluder_radius = 0.02;  ///< an occluder point blocks lines of sight passing closer than this [m]
-  /// Retreat (ofv::ViewLoop, told how much of the object each frame shows):
-  /// the loop remembers the camera position that showed the most of the
-  /// object in the last 0.5 s. When the camera has moved away from it and
-  /// shows this fraction of that less for two frames, because of its own
-  /// motion (with the occluders seen in that position's frame and this
-  /// frame's still ones that have not moved 5 cm since, score_view shows
-  /// this fraction less here than there), and
-  /// this frame's occluders do not make that position worse than the
-  /// current one, the camera goes back there and holds until t0 is clear
-  /// again or, back there, it shows this fraction less for 6 frames in a
-  /// row (the scene changed). A target that only a partial perception
-  /// believes clear (an occluder hidden behind another) so cannot lead the
-  /// camera into a cage that hides the object, and occluders that move in
-  /// do not send it back into their way. On the way to a steady target
-  /// (the estimator converging within 10 deg of the previous frame's target
-  /// for 10 frames: a way around an occluder) only a loss of more than half
-  /// counts, and a hold that began before the target was steady ends when
-  /// it is, but only once t0 has been clear: since the first frame (what
-  /// hid t0 from the start did not arrive, like a cage of occluders) and
-  /// since steadiness last ended a hold (a steady view failed: in a still
-  /// cage the false gaps are steady too). When perception loses the object
-  /// within 0.5 s of that position (or during a hold), the camera drives
-  /// back there and stops. 0 = off.
-  double retreat_drop = 0.1;
-  /// Look-ahead (with retreat_drop > 0, ofv::ViewLoop told what each frame
-  /// shows), until t0 has been clear in some frame: the camera does not go
-  /// on towards its target when, on the way (3 points on the great circle,
-  /// the last as far as it can travel before a frame shows a loss and it
-  /// stops: max_linear_speed x (frame age + one period) plus the braking
-  /// distance), score_view with the frame's occluders shows retreat_drop
-  /// less of the object than here (on the way to a steady target: half);
-  /// it climbs to a nearby view that sees clearly more (most_visible_view)
-  /// if the way there keeps what it sees, else it holds where it is
-  /// (holding alone, it would stay wherever it started). Until t0 has been
-  /// clear, what hides the object was there from the start and stands
-  /// still (a cage): the retreat acts once the camera has lost part of the
-  /// object, the look-ahead keeps it from losing it. Once t0 has been
-  /// clear, what hides the object came in and may stand on the way out of
-  /// a valley (an arm stopped over the object), where holding would keep
-  /// the camera there.
-  bool look_ahead = true;
 };
 
 /**
- * \brief The graceful view without a free view: scores (score_view) the
+ * \brief A view that sees clearly more, nearby (ofv::ViewLoop's look-ahead climbs there): scores (score_view) the
  *        current view, its 8 neighbours at `step_deg` around it and the
  *        `others`, all on the sphere, and returns the one that sees the
  *        largest fraction of the object, but the current view unless that
@@ -148,6 +107,6 @@ struct NoFreeViewSettings {
 [[nodiscard]] ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                                            double r_sphere, const Eigen::Vector3d& current,
                                            const std::vector<Eigen::Vector3d>& others,
-                                           const NoFreeViewSettings& settings);
+                                           const MostVisibleSettings& settings);
 
 }  // namespace ofv

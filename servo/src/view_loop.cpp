@@ -25,14 +25,6 @@ using Clock = std::chrono::steady_clock;
 // predicted occluders). 12 MB.
 constexpr std::size_t kReservedOcclusionPoints = 250'000;
 
-constexpr double kAway = 0.01;     // [m]: the camera has moved from a view
-constexpr double kEvidence = 0.5;  // [s]: how long what a view showed counts as evidence
-// A steady target: within kSteadyDeg of the previous frame's for
-// kSteadyFrames frames; on the way there, only a loss of more than
-// kSteadyLoss of what the camera showed counts (guard camera_cost_view).
-constexpr double kSteadyDeg = 10.0;
-constexpr int kSteadyFrames = 10;
-constexpr double kSteadyLoss = 0.5;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -192,25 +184,24 @@ SettingsTable<LoopSettings> make_table() {
           l.tracker.max_misses = static_cast<int>(parse_integer("track_max_misses", v, 0, 1000));
         },
         [](const L& l) { return std::to_string(l.tracker.max_misses); });
-  t.add({"retreat_drop", "number in [0, 1]", format_number(d.no_free_view.retreat_drop), "",
+  t.add({"retreat_drop", "number in [0, 1]", format_number(d.retreat.drop), "",
          "the fraction of the object the camera may see less, because it moved, than at the view that showed the "
          "most in the last 0.5 s, before it goes back there and holds (not when occluders moved in or came there "
-         "too; on the way to a steady free view, only a loss of more than half); the object lost soon after, it "
-         "drives back there too; 0 (off) to 1"},
-        [](L& l, const std::string& v) { l.no_free_view.retreat_drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
-        [](const L& l) { return format_number(l.no_free_view.retreat_drop); });
-  t.add({"look_ahead", "bool", format_bool(d.no_free_view.look_ahead), "",
+         "too); the object lost soon after, it drives back there too; 0 (off) to 1"},
+        [](L& l, const std::string& v) { l.retreat.drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
+        [](const L& l) { return format_number(l.retreat.drop); });
+  t.add({"look_ahead", "bool", format_bool(d.retreat.look_ahead), "",
          "with retreat_drop > 0, until t0 has been clear (what hides the object was there from the start): where, on "
          "its way to the target, the occluders would hide retreat_drop more of the object (as far as it travels before "
          "it could stop), the camera climbs to a nearby view that sees clearly more, or holds"},
-        [](L& l, const std::string& v) { l.no_free_view.look_ahead = parse_bool("look_ahead", v); },
-        [](const L& l) { return format_bool(l.no_free_view.look_ahead); });
-  t.add({"look_ahead_margin", "number in [0, 1]", format_number(d.no_free_view.margin), "",
+        [](L& l, const std::string& v) { l.retreat.look_ahead = parse_bool("look_ahead", v); },
+        [](const L& l) { return format_bool(l.retreat.look_ahead); });
+  t.add({"look_ahead_margin", "number in [0, 1]", format_number(d.retreat.climb.margin), "",
          "look_ahead: a nearby view the camera climbs to must see this fraction more of the object than the current one, 0 to 1"},
         [](L& l, const std::string& v) {
-          l.no_free_view.margin = parse_number("look_ahead_margin", v, 0.0, 1.0, false);
+          l.retreat.climb.margin = parse_number("look_ahead_margin", v, 0.0, 1.0, false);
         },
-        [](const L& l) { return format_number(l.no_free_view.margin); });
+        [](const L& l) { return format_number(l.retreat.climb.margin); });
   t.add({"max_linear_accel", "number in (0, 100]", format_number(d.safety.max_linear_accel), "m/s^2",
          "safety filter: largest change of the linear velocity"},
         [](L& l, const std::string& v) { l.safety.max_linear_accel = parse_number("max_linear_accel", v, 0.0, 100.0, true); },
@@ -268,7 +259,6 @@ const char* to_string(Guard guard) {
     case Guard::CameraCostView: return "camera_cost_view";
     case Guard::T0Clear: return "t0_clear";
     case Guard::SceneChanged: return "scene_changed";
-    case Guard::TargetSteady: return "target_steady";
     case Guard::ObjectLost: return "object_lost";
     case Guard::ObjectLostNoView: return "object_lost_no_view";
     case Guard::BackThere: return "back_there";
@@ -315,7 +305,6 @@ constexpr Transition kTransitions[] = {
     {LoopMode::Pursue, Guard::ObjectLostNoView, LoopMode::Lost},
     {LoopMode::Hold, Guard::T0Clear, LoopMode::Pursue},
     {LoopMode::Hold, Guard::SceneChanged, LoopMode::Pursue},
-    {LoopMode::Hold, Guard::TargetSteady, LoopMode::Pursue},
     {LoopMode::Hold, Guard::ObjectLost, LoopMode::WayBack},
     {LoopMode::WayBack, Guard::BackThere, LoopMode::Waiting},
     {LoopMode::WayBack, Guard::ObjectFound, LoopMode::Hold},
@@ -332,9 +321,17 @@ struct ViewLoop::Impl {
         estimator(s.estimator.resolve()),
         controller(s.controller),
         safety(s.safety),
-        world(s.tracker, s.anticipation.min_speed) {
+        world(s.tracker, s.anticipation.min_speed, s.retreat.arrival, s.retreat.moved) {
     if (settings.sampling.candidates < 1 || !(settings.sampling.occluder_radius > 0.0)) {
       throw std::invalid_argument("sampling settings: candidates must be >= 1 and occluder_radius positive");
+    }
+    const RetreatSettings& r = settings.retreat;
+    if (!(r.drop >= 0.0 && r.drop <= 1.0) || !(r.memory > 0.0) || r.frames < 1 || r.release_frames < 1 ||
+        !(r.at >= 0.0) || !(r.arrival >= 0.0) || !(r.moved >= 0.0) || r.look_ahead_samples < 1 ||
+        !(r.climb.step_deg > 0.0) || !(r.climb.margin >= 0.0) || !(r.climb.occluder_radius > 0.0)) {
+      throw std::invalid_argument(
+          "retreat settings: drop in [0, 1], memory > 0 s, frames, release_frames and look_ahead_samples >= 1, "
+          "at, arrival, moved and climb.margin >= 0, climb.step_deg and climb.occluder_radius > 0");
     }
   }
 
@@ -369,10 +366,9 @@ struct ViewLoop::Impl {
   Candidate look_ahead(const Frame& f, const Candidate& pursuit) const;
   // --- the mode machine
   void transition(Guard guard, LoopStep& out);
-  void update_steadiness(const Candidate& pursuit, const ViewEstimate& estimate);
   void found(const Frame& f, LoopStep& out);
   void lost(const Eigen::Vector3d& here, double dt, LoopStep& out);
-  bool camera_cost_view(const Frame& f, bool steady);
+  bool camera_cost_view(const Frame& f);
   [[nodiscard]] SeenView seen_here(const Frame& f) const {
     return SeenView{f.here, f.shown, f.problem.occluders.leftCols(f.seen), 0.0, world.positions()};
   }
@@ -389,10 +385,6 @@ struct ViewLoop::Impl {
   std::optional<SeenView> best_seen;  // the view that showed the most of the object
   std::optional<SeenView> held;       // modes hold, way back, waiting: that view
   int low_frames = 0;                 // frames in a row showing much less than best_seen or held
-  std::optional<Eigen::Vector3d> target_direction;  // last converged target, unit vector from C
-  int steady_frames = 0;              // frames in a row it stayed near the previous one
-  bool release_when_steady = false;   // the hold began on the way to a target not yet steady
-  bool steadiness_ends_holds = false; // t0 was clear in some frame since steadiness last ended a hold (or since the start)
   bool t0_was_clear = false;          // t0 was clear in some frame since the start
 };
 
@@ -415,10 +407,6 @@ void ViewLoop::Impl::reset() {
   best_seen.reset();
   held.reset();
   low_frames = 0;
-  target_direction.reset();
-  steady_frames = 0;
-  release_when_steady = false;
-  steadiness_ends_holds = false;
   t0_was_clear = false;
   last_centroid.reset();
 }
@@ -508,21 +496,22 @@ Candidate ViewLoop::Impl::pursue(const ViewProblem& problem, LoopStep& out) {
   return {chosen.tf, out.anticipated ? Proposer::Anticipated : Proposer::Estimate};
 }
 
-// NoFreeViewSettings::look_ahead: the pursuit's view, or when the way there
+// RetreatSettings::look_ahead: the pursuit's view, or when the way there
 // hides more of the object, a nearby view that sees more (most_visible_view)
 // or the camera's own view (hold).
 Candidate ViewLoop::Impl::look_ahead(const Frame& f, const Candidate& pursuit) const {
-  const NoFreeViewSettings& s = settings.no_free_view;
+  const RetreatSettings& s = settings.retreat;
   // Only until t0 has been clear: what hides the object was there from the
   // start and stands still (a cage). What came in since may stand on the
   // way out of the valley the camera is in, where going on beats holding
   // (an arm that stopped over the object; the retreat still acts on a loss).
   if (!s.look_ahead || !pursuit.view || t0_was_clear) return pursuit;
+  const double away = s.at;
   const Eigen::Vector3d& c = f.estimate.centroid;
   const double r = estimator.r_sphere;
   const Eigen::Vector3d from = (f.here - c).normalized();
   const auto score = [&](const Eigen::Vector3d& direction) {
-    return score_view(f.problem, c, r, c + r * direction, s.occluder_radius).visible_fraction;
+    return score_view(f.problem, c, r, c + r * direction, s.climb.occluder_radius).visible_fraction;
   };
   const double now = score(from);
   // How far the camera may go before a frame shows the loss and it stops:
@@ -530,26 +519,24 @@ Candidate ViewLoop::Impl::look_ahead(const Frame& f, const Candidate& pursuit) c
   const double v = settings.safety.max_linear_speed;
   const double a = settings.safety.max_linear_accel;
   const double reach = v * (std::max(f.age, 0.0) + f.dt) + v * v / (2.0 * a);
-  const bool steady = steady_frames >= kSteadyFrames;
   // Whether the way to `goal` (3 points on the great circle, the last at
   // `reach`) loses what the look-ahead counts.
   const auto loses_on_the_way = [&](const Eigen::Vector3d& goal) {
     const Eigen::Vector3d to = (goal - c).normalized();
     const double angle = std::acos(std::clamp(from.dot(to), -1.0, 1.0));
-    if (r * angle <= kAway || !(std::sin(angle) > 1e-9)) return false;  // there, or straight across: no one way
+    if (r * angle <= away || !(std::sin(angle) > 1e-9)) return false;  // there, or straight across: no one way
     double worst = now;
-    constexpr int kSamples = 3;
-    for (int k = 1; k <= kSamples; ++k) {
-      const double along = std::min(angle, reach / r) * k / kSamples;  // from `from` towards `to`
+    for (int k = 1; k <= s.look_ahead_samples; ++k) {
+      const double along = std::min(angle, reach / r) * k / s.look_ahead_samples;  // from `from` towards `to`
       worst = std::min(worst, score((std::sin(angle - along) * from + std::sin(along) * to) / std::sin(angle)));
     }
-    return worst < (1.0 - s.retreat_drop) * now && (!steady || worst < kSteadyLoss * now);
+    return worst < (1.0 - s.drop) * now;
   };
   if (!loses_on_the_way(*pursuit.view)) return pursuit;
   // Climb to a nearby view that sees clearly more, if the way there keeps
   // what the camera sees (holding alone, it would stay wherever it
   // started); else hold.
-  const Eigen::Vector3d climb = most_visible_view(f.problem, c, r, f.here, {}, s).view;
+  const Eigen::Vector3d climb = most_visible_view(f.problem, c, r, f.here, {}, s.climb).view;
   if (loses_on_the_way(climb)) return {Eigen::Vector3d(c + r * from), Proposer::Here};
   return {climb, Proposer::Climb};
 }
@@ -563,90 +550,58 @@ void ViewLoop::Impl::transition(Guard guard, LoopStep& out) {
   out.guard = guard;
 }
 
-// A steady free view: the estimator converges, frame after frame, to a
-// target within kSteadyDeg of the previous frame's, for kSteadyFrames frames.
-void ViewLoop::Impl::update_steadiness(const Candidate& pursuit, const ViewEstimate& estimate) {
-  if (pursuit.view && estimate.status == ViewStatus::Converged) {
-    const Eigen::Vector3d direction = (*pursuit.view - estimate.centroid).normalized();
-    const bool near = target_direction && direction.dot(*target_direction) >= std::cos(kSteadyDeg * EIGEN_PI / 180.0);
-    steady_frames = near ? steady_frames + 1 : 1;
-    target_direction = direction;
-  } else {
-    steady_frames = 0;
-    target_direction.reset();
-  }
-}
-
 // Guard camera_cost_view (mode pursue), with the evidence it keeps: the view
-// that showed the most in the last kEvidence, and the frames in a row that
-// showed retreat_drop less away from it.
-//
-// A way around an occluder stays where it is, and the camera may lose some
-// of the object on its way there (past the occluder's edge): unless it
-// loses more than half of what it showed (kSteadyLoss), a steady target is
-// no reason to retreat. The loss must come from the camera's own motion:
-// with the occluders as they were when that view showed the most, and those
-// of this frame known to stand still (revealed by the motion), here shows
-// less than there by retreat_drop too; occluders that moved in since cost
-// the object wherever the camera is. And this frame's occluders must make
-// that view clearly better, or at least not worse where they hide most of
-// the object from here.
-bool ViewLoop::Impl::camera_cost_view(const Frame& f, bool steady) {
-  const NoFreeViewSettings& s = settings.no_free_view;
-  constexpr int kFrames = 2;  // a loss counts when it lasts this many frames (one frame is noise)
-  const double keep = 1.0 - s.retreat_drop;
+// that showed the most in the last `memory`, and the frames in a row that
+// showed `drop` less away from it. The loss must come from the
+// camera's own motion: with the occluders as they were when that view
+// showed the most, and those of this frame known to stand still (revealed
+// by the motion: WorldModel::revealed_still), here shows less than there by
+// `drop` too (occluders that moved in since cost the object wherever
+// the camera is); and with this frame's occluders, that view must not show
+// less than here (they came there too).
+bool ViewLoop::Impl::camera_cost_view(const Frame& f) {
+  const RetreatSettings& s = settings.retreat;
+  const double keep = 1.0 - s.drop;
   if (best_seen) best_seen->age += f.dt;
-  // What a view showed longer ago than kEvidence is no evidence any more
+  // What a view showed longer ago than `memory` is no evidence any more
   // (the occluders move): the current view starts again.
-  if (!best_seen || f.shown >= best_seen->shown || !(best_seen->age <= kEvidence)) {
+  if (!best_seen || f.shown >= best_seen->shown || !(best_seen->age <= s.memory)) {
     best_seen = seen_here(f);
     low_frames = 0;
     return false;
   }
-  const bool away = (f.here - best_seen->position).norm() > kAway;
-  const bool less = f.shown < keep * best_seen->shown && (!steady || f.shown < kSteadyLoss * best_seen->shown);
-  low_frames = away && less ? low_frames + 1 : 0;
-  if (low_frames < kFrames) return false;
+  const bool away = (f.here - best_seen->position).norm() > s.at;
+  low_frames = away && f.shown < keep * best_seen->shown ? low_frames + 1 : 0;
+  if (low_frames < s.frames) return false;
   const Eigen::Vector3d& c = f.estimate.centroid;
   const double r = estimator.r_sphere;
   const auto score = [&](const ViewProblem& scene, const Eigen::Vector3d& p) {
-    return score_view(scene, c, r, c + r * (p - c).normalized(), s.occluder_radius).visible_fraction;
+    return score_view(scene, c, r, c + r * (p - c).normalized(), s.climb.occluder_radius).visible_fraction;
   };
   const Eigen::Matrix3Xd still = world.revealed_still(best_seen->tracks);
   ViewProblem then = f.problem;
   then.occluders.resize(3, best_seen->occluders.cols() + still.cols());
   then.occluders << best_seen->occluders, still;
   if (!(score(then, f.here) < keep * score(then, best_seen->position))) return false;
-  const double here_score = score(f.problem, f.here);
-  const double margin = here_score < 0.5 ? 0.0 : 0.1;
-  return !(score(f.problem, best_seen->position) < here_score + margin);  // else the occluders came there too
+  return score(f.problem, best_seen->position) >= score(f.problem, f.here);
 }
 
 // The mode machine in a frame that found the object (the retreat on).
 void ViewLoop::Impl::found(const Frame& f, LoopStep& out) {
-  const NoFreeViewSettings& s = settings.no_free_view;
-  constexpr int kReleaseFrames = 6;  // back at the held view, this many frames showing less release it
-  const double keep = 1.0 - s.retreat_drop;
-  const bool steady = steady_frames >= kSteadyFrames;
-  if (f.estimate.iterations == 0) steadiness_ends_holds = t0_was_clear = true;
+  const RetreatSettings& s = settings.retreat;
+  const double keep = 1.0 - s.drop;
+  if (f.estimate.iterations == 0) t0_was_clear = true;
   if (mode == LoopMode::WayBack || mode == LoopMode::Waiting || mode == LoopMode::Lost) {
     transition(Guard::ObjectFound, out);
   }
   if (mode == LoopMode::Hold) {
-    const bool there = (f.here - held->position).norm() <= kAway;
+    const bool there = (f.here - held->position).norm() <= s.at;
     low_frames = there && f.shown < keep * held->shown ? low_frames + 1 : 0;
     Guard release = Guard::None;
     if (f.estimate.iterations == 0) {
       release = Guard::T0Clear;
-    } else if (low_frames >= kReleaseFrames) {
+    } else if (low_frames >= s.release_frames) {
       release = Guard::SceneChanged;
-    } else if (steady && release_when_steady) {
-      // A hold that began while the target was not yet steady (an occluder
-      // arriving) ends when it is; from then on, steadiness ends no hold
-      // until t0 has been clear again (a steady view failed: in a still
-      // cage the false gaps are steady too).
-      release = Guard::TargetSteady;
-      steadiness_ends_holds = false;
     }
     if (release == Guard::None) return;
     transition(release, out);
@@ -655,12 +610,9 @@ void ViewLoop::Impl::found(const Frame& f, LoopStep& out) {
     low_frames = 0;
     return;
   }
-  if (camera_cost_view(f, steady)) {
+  if (camera_cost_view(f)) {
     transition(Guard::CameraCostView, out);
     held = best_seen;
-    // Steadiness ends this hold only if it began on the way to a target not
-    // yet steady, and t0 has been clear since steadiness last ended one.
-    release_when_steady = !steady && steadiness_ends_holds;
     low_frames = 0;
   }
 }
@@ -670,10 +622,9 @@ void ViewLoop::Impl::lost(const Eigen::Vector3d& here, double dt, LoopStep& out)
   if (mode == LoopMode::Pursue || mode == LoopMode::Lost) {
     if (best_seen) best_seen->age += dt;
     if (mode == LoopMode::Pursue) {
-      if (best_seen && best_seen->age <= kEvidence) {
+      if (best_seen && best_seen->age <= settings.retreat.memory) {
         transition(Guard::ObjectLost, out);
         held = best_seen;
-        release_when_steady = false;
         low_frames = 0;
       } else {
         transition(Guard::ObjectLostNoView, out);
@@ -682,7 +633,7 @@ void ViewLoop::Impl::lost(const Eigen::Vector3d& here, double dt, LoopStep& out)
   } else if (mode == LoopMode::Hold) {
     transition(Guard::ObjectLost, out);
   }
-  const bool there = held && (here - held->position).norm() <= kAway;
+  const bool there = held && (here - held->position).norm() <= settings.retreat.at;
   if (mode == LoopMode::WayBack && there) transition(Guard::BackThere, out);
   if (mode == LoopMode::Waiting && !there) transition(Guard::AwayAgain, out);
 }
@@ -709,8 +660,8 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
   const Eigen::Matrix3Xd seen_occluders = problem ? Eigen::Matrix3Xd(problem->occluders.leftCols(seen)) : Eigen::Matrix3Xd();
   out.tracks = world.update(problem ? &seen_occluders : nullptr, dt);
 
-  // The retreat's mode machine runs with the estimator, a known shown area and retreat_drop > 0.
-  const bool retreat = settings.method == ViewMethod::Estimator && settings.no_free_view.retreat_drop > 0.0;
+  // The retreat's modes need the estimator, a known shown area and retreat_drop > 0.
+  const bool retreat = settings.method == ViewMethod::Estimator && settings.retreat.drop > 0.0;
   Candidate selected;
   if (out.estimate) {
     switch (out.estimate->status) {
@@ -723,7 +674,6 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
     selected = pursuit;
     if (retreat && observation.shown_area) {
       const Frame f{*problem, seen, *out.estimate, here, *observation.shown_area, dt, observation.age};
-      update_steadiness(pursuit, *out.estimate);
       found(f, out);
       if (mode == LoopMode::Pursue) selected = look_ahead(f, pursuit);
       if (mode == LoopMode::Hold) selected = {held->position, Proposer::BestSeen};

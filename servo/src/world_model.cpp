@@ -6,17 +6,6 @@
 
 namespace ofv {
 
-namespace {
-
-// Moving within this time of being first seen, a track came into view
-// moving: it arrived, the camera did not reveal it.
-constexpr double kArrival = 0.3;  // [s]
-// A track that stands still now came there, and was not revealed by the
-// camera, when it moved farther than this since the view it is compared with.
-constexpr double kMovedSince = 0.05;  // [m]
-
-}  // namespace
-
 const std::vector<OccluderTrack>& WorldModel::update(const Eigen::Matrix3Xd* seen, double dt) {
   const bool timed = std::isfinite(dt) && dt > 0.0;
   if (!timed) {  // no time base: start the tracks again
@@ -46,7 +35,7 @@ void WorldModel::remember(double dt) {
       h = known->second;
       h.age += dt;
     }
-    h.arrived = h.arrived || (h.age <= kArrival && is_moving(t, min_speed_));
+    h.arrived = h.arrived || (h.age <= arrival_ && is_moving(t, min_speed_));
     history.emplace(t.id, h);
   }
   history_ = std::move(history);
@@ -78,7 +67,7 @@ Eigen::Matrix3Xd WorldModel::revealed_still(const TrackPositions& then) const {
     const History& history = history_.at(t.id);
     const auto was = std::find_if(then.begin(), then.end(), [&](const auto& p) { return p.first == t.id; });
     const Eigen::Vector3d& since = was != then.end() ? was->second : history.first_position;
-    if (!history.arrived && (t.position - since).norm() <= kMovedSince) still.push_back(t);
+    if (!history.arrived && (t.position - since).norm() <= moved_) still.push_back(t);
   }
   return still_occluders(still, min_speed_);
 }

@@ -17,8 +17,10 @@ using TrackPositions = std::vector<std::pair<int, Eigen::Vector3d>>;
 
 class WorldModel {
  public:
-  /// `min_speed`: tracks slower than this stand still (AnticipationSettings::min_speed).
-  WorldModel(const TrackerSettings& tracker, double min_speed) : tracker_(tracker), min_speed_(min_speed) {}
+  /// `min_speed`: tracks slower than this stand still (AnticipationSettings::min_speed);
+  /// `arrival`, `moved`: RetreatSettings' (revealed_still()).
+  WorldModel(const TrackerSettings& tracker, double min_speed, double arrival, double moved)
+      : tracker_(tracker), min_speed_(min_speed), arrival_(arrival), moved_(moved) {}
 
   /// The frame's seen occluders (none: the object lost, the tracks coast).
   /// A period that is not finite and positive starts the tracks again.
@@ -32,9 +34,10 @@ class WorldModel {
   [[nodiscard]] Eigen::Matrix3Xd predicted(double horizon, int samples, const Eigen::Vector3d& centroid,
                                            double r_sphere) const;
   /// This frame's points of the tracks that stand still, did not come into
-  /// view moving, and stood where they are when `then` was recorded (or, not
-  /// tracked then, where they were first seen): what the camera's own motion
-  /// may have revealed since.
+  /// view moving (within `arrival` of being first seen), and stood within
+  /// `moved` of where they are when `then` was recorded (or, not tracked
+  /// then, of where they were first seen): what the camera's own motion may
+  /// have revealed since.
   [[nodiscard]] Eigen::Matrix3Xd revealed_still(const TrackPositions& then) const;
 
  private:
@@ -47,7 +50,7 @@ class WorldModel {
   void remember(double dt);
 
   OccluderTracker tracker_;
-  double min_speed_;
+  double min_speed_, arrival_, moved_;
   std::map<int, History> history_;  // of each current track, by id
 };
 

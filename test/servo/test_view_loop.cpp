@@ -178,7 +178,7 @@ Eigen::Vector3d leave(ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, do
 // view; returns the last target.
 Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, double shown_on_way = 50.0) {
   LoopSettings settings;
-  settings.no_free_view.retreat_drop = retreat_drop;
+  settings.retreat.drop = retreat_drop;
   ViewLoop loop(settings);
   const Eigen::Vector3d away = stay(loop, settle);
   EXPECT_GT(away.norm(), 0.05);
@@ -278,7 +278,7 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
 
   // Without the retreat (retreat_drop = 0), or lost longer than 0.5 s after
   // the view that showed the most, a lost object stops the camera.
-  settings.no_free_view.retreat_drop = 0.0;
+  settings.retreat.drop = 0.0;
   ViewLoop no_retreat(settings);
   (void)stay(no_retreat, 1);
   (void)no_retreat.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
@@ -322,53 +322,6 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
   EXPECT_EQ(c.presumed_occluders, 39);
 }
 
-TEST(ViewLoop, OnTheWayToASteadyFreeViewOnlyLosingMoreThanHalfRetreats) {
-  // The estimator has converged to the same view for 12 frames (a way
-  // around an occluder): losing 40 % on the way there is no reason to go
-  // back, losing 60 % still is.
-  EXPECT_GT(after_leaving(0.2, Loss::Revealed, 12, 60.0).norm(), 0.05);
-  EXPECT_LT(after_leaving(0.2, Loss::Revealed, 12, 40.0).norm(), 1e-12);
-  // Without the steady frames, 40 % is enough.
-  EXPECT_LT(after_leaving(0.2, Loss::Revealed, 1, 60.0).norm(), 1e-12);
-}
-
-TEST(ViewLoop, UntilT0HasBeenClearSteadinessDoesNotEndAHold) {
-  // t0 is occluded from the first frame on: no occluder arrived (like a
-  // cage of still occluders). The camera leaves for the estimator's view
-  // and loses 60 %: the hold is not ended by steadiness, only by t0
-  // becoming clear.
-  LoopSettings settings;
-  settings.no_free_view.retreat_drop = 0.2;
-  ViewLoop loop(settings);
-  const Eigen::Vector3d away = stay(loop, 1);
-  ASSERT_LT(leave(loop, away, Loss::Revealed, 40.0).norm(), 1e-12);
-  EXPECT_LT(stay(loop, 30).norm(), 1e-12);  // held, however steady
-  see_t0_clear(loop);
-  EXPECT_LT((stay(loop, 1) - away).norm(), 1e-9);
-}
-
-TEST(ViewLoop, AfterASteadyViewFailedSteadinessNoLongerEndsAHold) {
-  // t0 was clear, then occluded. The first hold began before the target
-  // was steady: back at the origin, ten frames converging to the same view
-  // end it. The camera leaves for another view (an occluder on the other
-  // side: not steady yet) and loses 60 % again: that hold is not ended by
-  // steadiness (a steady view failed), only by t0 becoming clear.
-  LoopSettings settings;
-  settings.no_free_view.retreat_drop = 0.2;
-  ViewLoop loop(settings);
-  see_t0_clear(loop);
-  const Eigen::Vector3d away = stay(loop, 1);
-  ASSERT_LT(leave(loop, away, Loss::Revealed, 40.0).norm(), 1e-12);
-  EXPECT_LT(stay(loop, 5).norm(), 1e-12);           // held
-  ASSERT_LT((stay(loop, 10) - away).norm(), 1e-9);  // steady: released
-  const Eigen::Vector3d other = stay(loop, 1, -1.0);
-  ASSERT_GT((other - away).norm(), 0.1);
-  ASSERT_LT(leave(loop, other, Loss::Revealed, 40.0, -1.0).norm(), 1e-12);
-  EXPECT_LT(stay(loop, 30, -1.0).norm(), 1e-12);  // held, however steady
-  see_t0_clear(loop);  // the hold ends
-  EXPECT_LT((stay(loop, 1, -1.0) - other).norm(), 1e-9);
-}
-
 // The first frame's target at the origin with one still occluder point 5 cm
 // in front of the camera's way `along` m from the origin towards the
 // estimator's view (`side` rad around the line of sight: 0 = on the way),
@@ -394,7 +347,7 @@ Post with_a_post(double along, double side, bool t0_was_clear = false) {
   p.occluders.col(9) = there + 0.05 * (object - there).normalized();
   const auto target = [&](bool look_ahead) {
     LoopSettings settings;
-    settings.no_free_view.look_ahead = look_ahead;
+    settings.retreat.look_ahead = look_ahead;
     ViewLoop loop(settings);
     if (t0_was_clear) see_t0_clear(loop);
     const LoopStep s = loop.step(observed(p, vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);

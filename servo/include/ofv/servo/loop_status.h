@@ -56,7 +56,6 @@ enum class Guard {
   CameraCostView,  ///< pursue → hold: the camera's own motion cost retreat_drop of what that view showed
   T0Clear,         ///< hold → pursue: t0 is clear
   SceneChanged,    ///< hold → pursue: back there, it keeps showing retreat_drop less (the scene changed)
-  TargetSteady,    ///< hold → pursue: the target the hold interrupted on its way became steady
   ObjectLost,      ///< pursue | hold → way back: the object lost within 0.5 s of that view, or while holding
   ObjectLostNoView,  ///< pursue → lost: the object lost with no such view
   BackThere,       ///< way back → waiting
