@@ -291,29 +291,25 @@ struct Candidate {
   Proposer by = Proposer::None;
 };
 
-// The mode machine: each transition's mode, guard and next mode. In a
-// frame the current mode's guards are tried in this order and the first
-// that holds is taken (ViewLoop::Impl::found and lost evaluate them).
-struct Transition {
-  LoopMode from;
-  Guard guard;
-  LoopMode to;
-};
-constexpr Transition kTransitions[] = {
-    {LoopMode::Pursue, Guard::CameraCostView, LoopMode::Hold},
-    {LoopMode::Pursue, Guard::ObjectLost, LoopMode::WayBack},
-    {LoopMode::Pursue, Guard::ObjectLostNoView, LoopMode::Lost},
-    {LoopMode::Hold, Guard::T0Clear, LoopMode::Pursue},
-    {LoopMode::Hold, Guard::SceneChanged, LoopMode::Pursue},
-    {LoopMode::Hold, Guard::ObjectLost, LoopMode::WayBack},
-    {LoopMode::WayBack, Guard::BackThere, LoopMode::Waiting},
-    {LoopMode::WayBack, Guard::ObjectFound, LoopMode::Hold},
-    {LoopMode::Waiting, Guard::AwayAgain, LoopMode::WayBack},
-    {LoopMode::Waiting, Guard::ObjectFound, LoopMode::Hold},
-    {LoopMode::Lost, Guard::ObjectFound, LoopMode::Pursue},
-};
 
 }  // namespace
+
+const std::vector<LoopTransition>& loop_transitions() {
+  static const std::vector<LoopTransition> table{
+      {LoopMode::Pursue, Guard::CameraCostView, LoopMode::Hold},
+      {LoopMode::Pursue, Guard::ObjectLost, LoopMode::WayBack},
+      {LoopMode::Pursue, Guard::ObjectLostNoView, LoopMode::Lost},
+      {LoopMode::Hold, Guard::T0Clear, LoopMode::Pursue},
+      {LoopMode::Hold, Guard::SceneChanged, LoopMode::Pursue},
+      {LoopMode::Hold, Guard::ObjectLost, LoopMode::WayBack},
+      {LoopMode::WayBack, Guard::BackThere, LoopMode::Waiting},
+      {LoopMode::WayBack, Guard::ObjectFound, LoopMode::Hold},
+      {LoopMode::Waiting, Guard::AwayAgain, LoopMode::WayBack},
+      {LoopMode::Waiting, Guard::ObjectFound, LoopMode::Hold},
+      {LoopMode::Lost, Guard::ObjectFound, LoopMode::Pursue},
+  };
+  return table;
+}
 
 struct ViewLoop::Impl {
   explicit Impl(const LoopSettings& s)
@@ -542,10 +538,12 @@ Candidate ViewLoop::Impl::look_ahead(const Frame& f, const Candidate& pursuit) c
 }
 
 void ViewLoop::Impl::transition(Guard guard, LoopStep& out) {
-  const auto t = std::find_if(std::begin(kTransitions), std::end(kTransitions),
-                              [&](const Transition& x) { return x.from == mode && x.guard == guard; });
-  if (t == std::end(kTransitions)) throw std::logic_error(std::string("ViewLoop: no transition from ") +
-                                                          to_string(mode) + " by " + to_string(guard));
+  const std::vector<LoopTransition>& table = loop_transitions();
+  const auto t = std::find_if(table.begin(), table.end(),
+                              [&](const LoopTransition& x) { return x.from == mode && x.guard == guard; });
+  if (t == table.end()) {
+    throw std::logic_error(std::string("ViewLoop: no transition from ") + to_string(mode) + " by " + to_string(guard));
+  }
   mode = t->to;
   out.guard = guard;
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 
 namespace ofv {
@@ -131,6 +132,47 @@ TEST(Episode, PerceptionIsScoredOnEveryFrame) {
   EXPECT_NEAR(full.metrics.mean_visible_fraction, labels.metrics.mean_visible_fraction, 0.01);
   EXPECT_FALSE(truth.metrics.perception.scored());
   for (const StepRecord& s : truth.steps) EXPECT_FALSE(s.perception.object_recall);
+}
+
+TEST(Episode, EveryModeChangeIsATransitionOfTheTable) {
+  // The cage of no-free-view with one frame of latency: the camera loses
+  // part of the object, holds, loses it, drives back (full perception, seed
+  // 0). Each frame's mode follows from the previous one by the guard it
+  // reports: one transition of loop_transitions(), or, when the object was
+  // found or lost again, that one and then one of the new mode's.
+  const EpisodeOutcome o = run_episode(
+      resolve_episode(sim::load_scenario("no-free-view"), {{"perception", "full"}, {"latency", "1"}}));
+  const auto& table = loop_transitions();
+  const auto edge = [&](LoopMode from, Guard guard, LoopMode to) {
+    return std::any_of(table.begin(), table.end(),
+                       [&](const LoopTransition& t) { return t.from == from && t.guard == guard && t.to == to; });
+  };
+  std::map<LoopMode, int> frames;
+  LoopMode before = LoopMode::Lost;  // a loop's mode before its first frame
+  for (const StepRecord& s : o.steps) {
+    ++frames[s.mode];
+    if (s.guard == Guard::None) {
+      EXPECT_EQ(s.mode, before) << s.time;
+    } else {
+      bool path = edge(before, s.guard, s.mode);
+      for (const LoopTransition& first : table) {
+        const bool again = first.guard == Guard::ObjectFound || first.guard == Guard::ObjectLost;
+        path = path || (first.from == before && again && edge(first.to, s.guard, s.mode));
+      }
+      EXPECT_TRUE(path) << s.time << ": " << to_string(before) << " by " << to_string(s.guard) << " to "
+                        << to_string(s.mode);
+    }
+    // Each mode's target comes from its proposers.
+    if (s.mode == LoopMode::Hold || s.mode == LoopMode::WayBack) {
+      EXPECT_EQ(s.proposer, Proposer::BestSeen) << s.time;
+    }
+    if (s.mode == LoopMode::Waiting || s.mode == LoopMode::Lost) {
+      EXPECT_EQ(s.proposer, Proposer::None) << s.time;
+    }
+    before = s.mode;
+  }
+  EXPECT_GT(frames[LoopMode::Hold], 0);
+  EXPECT_GT(frames[LoopMode::WayBack], 0);
 }
 
 TEST(Episode, SettingsAreValidatedByName) {

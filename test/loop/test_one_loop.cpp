@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -20,6 +21,7 @@ namespace fs = std::filesystem;
 struct Command {
   std::string status;
   std::vector<double> v;
+  std::string mode, proposer;  ///< the policy's decision (LoopStep::mode, LoopStep::proposer)
 };
 
 // trajectory.csv: status and velocity columns by name.
@@ -38,6 +40,8 @@ std::vector<Command> episode_commands(const fs::path& csv) {
     Command c;
     for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) {
       if (header[i] == "status") c.status = cells[i];
+      if (header[i] == "mode") c.mode = cells[i];
+      if (header[i] == "proposer") c.proposer = cells[i];
       for (const char* name : {"vx", "vy", "vz", "wx", "wy", "wz"}) {
         if (header[i] == name) c.v.push_back(std::stod(cells[i]));
       }
@@ -54,7 +58,8 @@ std::vector<Command> dry_run_commands(const std::string& out) {
   for (std::string line; std::getline(in, line);) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const auto j = nlohmann::json::parse(line);
-    commands.push_back({j.at("status").get<std::string>(), j.at("v").get<std::vector<double>>()});
+    commands.push_back({j.at("status").get<std::string>(), j.at("v").get<std::vector<double>>(),
+                        j.value("mode", ""), j.value("proposer", "")});
   }
   return commands;
 }
@@ -81,9 +86,14 @@ TEST(OneLoop, RunReplaysTheCommandsOfASimulatedEpisode) {
   std::vector<Command> commands = dry_run_commands(replay.out);
   ASSERT_EQ(commands.size(), episode.size() + 1);
   EXPECT_EQ(commands.back().status, "stop");  // the final command leaves the robot at rest
-  EXPECT_EQ(largest_difference({commands.back()}, {Command{"", std::vector<double>(6, 0.0)}}), 0.0);
+  EXPECT_EQ(largest_difference({commands.back()}, {Command{"", std::vector<double>(6, 0.0), "", ""}}), 0.0);
   commands.pop_back();
-  for (std::size_t k = 0; k < episode.size(); ++k) EXPECT_EQ(commands[k].status, episode[k].status) << "frame " << k;
+  for (std::size_t k = 0; k < episode.size(); ++k) {
+    EXPECT_EQ(commands[k].status, episode[k].status) << "frame " << k;
+    // The same decisions: the mode and the proposer of each frame's target.
+    EXPECT_EQ(commands[k].mode, episode[k].mode) << "frame " << k;
+    EXPECT_EQ(commands[k].proposer, episode[k].proposer) << "frame " << k;
+  }
   EXPECT_LE(largest_difference(commands, episode), 1e-9);
 
   // Other settings, other commands: the comparison can fail.
@@ -141,6 +151,29 @@ TEST(OneLoop, RehearsalRunsInWallClockTimeOnTheThreadedArm) {
   EXPECT_NE(r.out.find("distance to the sphere"), std::string::npos) << r.out;
   EXPECT_EQ(run("run --robot camera --source sim:dvd-one-hand").code, 2);  // no threaded free-flying camera
   EXPECT_EQ(run("run --robot viper850 --source sim:no-such-scenario").code, 2);
+}
+
+TEST(OneLoop, TheRehearsalRunsTheSimulationsPolicyWithGroundTruthToo) {
+  // In the cage of no-free-view the look-ahead holds the camera or climbs
+  // (proposers here, climb): it needs how much of the object each frame
+  // shows. With perception=ground-truth both drivers get it from the same
+  // observation of the frame (the labels' object voxels), not the
+  // simulator's visible fraction, and both look ahead.
+  const fs::path dir = fs::path(test::scratch_dir()) / "rehearsal_policy";
+  const std::string settings = " --set perception=ground-truth --set duration=1.5";
+  const CommandRun sim = run("simulate no-free-view --set robot=viper850 --no-pictures --out " + dir.string() + settings);
+  ASSERT_EQ(sim.code, 0) << sim.err;
+  const CommandRun rehearsal = run("run --robot viper850 --source sim:no-free-view --dry-run" + settings);
+  ASSERT_EQ(rehearsal.code, 0) << rehearsal.err;
+  const auto looks_ahead = [](const std::vector<Command>& commands) {
+    return std::count_if(commands.begin(), commands.end(),
+                         [](const Command& c) { return c.proposer == "here" || c.proposer == "climb"; });
+  };
+  const std::vector<Command> simulated = episode_commands(dir / "trajectory.csv");
+  const std::vector<Command> rehearsed = dry_run_commands(rehearsal.out.substr(0, rehearsal.out.find("ofv run:")));
+  ASSERT_GE(rehearsed.size(), 3U);
+  EXPECT_GT(looks_ahead(simulated), static_cast<long>(simulated.size()) / 2);
+  EXPECT_GT(looks_ahead(rehearsed), static_cast<long>(rehearsed.size()) / 2);
 }
 
 TEST(OneLoop, RehearsalTracksTheScenariosObject) {

@@ -5,6 +5,8 @@
  */
 #pragma once
 
+#include <vector>
+
 namespace ofv {
 
 /// \brief What the loop did with one frame.
@@ -64,6 +66,16 @@ enum class Guard {
 };
 /// \brief The word in files and on the terminal, e.g. camera_cost_view, t0_clear.
 [[nodiscard]] const char* to_string(Guard guard);
+
+/// \brief One transition of the mode machine: in mode `from`, guard `guard` moves the loop to `to`.
+struct LoopTransition {
+  LoopMode from;  ///< the mode it leaves
+  Guard guard;    ///< the guard that holds
+  LoopMode to;    ///< the mode it enters
+};
+/// \brief Every transition of ViewLoop's mode machine; in a frame, the current
+///        mode's guards are tried in this order and the first that holds is taken.
+[[nodiscard]] const std::vector<LoopTransition>& loop_transitions();
 
 /// \brief Which proposer's view the controller drives to.
 enum class Proposer {
