@@ -138,10 +138,11 @@ struct LoopSettings {
 };
 
 /**
- * \brief The loop's settings by name: the estimator's (ofv::estimator_settings_table())
- *        and method, sampling_candidates, sampling_occluder_radius, controller,
- *        gain, adaptive_gain, max_linear_speed, max_angular_speed, target_filter,
- *        target_hysteresis, max_linear_accel, max_angular_accel, stale_timeout, workspace.
+ * \brief The loop's settings by name: the estimator's (ofv::estimator_settings_table()),
+ *        then the view method and sampling, the controller, the target's
+ *        continuity, anticipation and the occluder tracks, the retreat and
+ *        look-ahead, and the safety filter (`ofv settings` lists them,
+ *        docs/settings.md is generated from it).
  */
 [[nodiscard]] const SettingsTable<LoopSettings>& loop_settings_table();
 
