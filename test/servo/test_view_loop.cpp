@@ -266,29 +266,46 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   (void)loop.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
   LoopStep s = loop.step(observed(std::nullopt, at(away), 0.0), dt);
   EXPECT_EQ(s.status, StepStatus::ObjectLost);
+  EXPECT_EQ(s.guard, Guard::ObjectLost);
+  EXPECT_EQ(s.mode, LoopMode::WayBack);
+  EXPECT_EQ(s.proposer, Proposer::BestSeen);
   ASSERT_TRUE(s.target);
   EXPECT_LT(s.target->norm(), 1e-12);
   EXPECT_NE(s.safety, SafetyAction::ObjectLost);
   EXPECT_LT(s.velocity[0], -1e-3);  // camera frame = world frame here: towards the origin
   EXPECT_LE(speed(s.velocity), settings.safety.max_linear_speed + 1e-12);
   s = loop.step(observed(std::nullopt, at(Eigen::Vector3d(0.005, 0, 0)), 0.0), dt);
+  EXPECT_EQ(s.guard, Guard::BackThere);
+  EXPECT_EQ(s.mode, LoopMode::Waiting);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+  // Found again there: it holds that view (guard object_found), until t0 is clear.
+  s = loop.step(observed(occluded_patch(), at(Eigen::Vector3d(0.005, 0, 0)), 0.0, 100.0), dt);
+  EXPECT_EQ(s.guard, Guard::ObjectFound);
+  EXPECT_EQ(s.mode, LoopMode::Hold);
+  s = loop.step(observed(patch(false), at(Eigen::Vector3d(0.005, 0, 0)), 0.0, 100.0), dt);
+  EXPECT_EQ(s.guard, Guard::T0Clear);
+  EXPECT_EQ(s.mode, LoopMode::Pursue);
+  EXPECT_EQ(s.proposer, Proposer::Estimate);
 
-  // Without the retreat (retreat_drop = 0), or lost longer than 0.5 s after
-  // the view that showed the most, a lost object stops the camera.
+  // Without the retreat (retreat_drop = 0), or lost where the camera has
+  // been for longer than 0.5 s (the best view since is here), a lost object
+  // stops the camera.
   settings.retreat.drop = 0.0;
   ViewLoop no_retreat(settings);
   (void)stay(no_retreat, 1);
   (void)no_retreat.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
   s = no_retreat.step(observed(std::nullopt, at(away), 0.0), dt);
+  EXPECT_EQ(s.mode, LoopMode::Lost);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
   ViewLoop late(LoopSettings{});
   (void)stay(late, 1);
   for (int k = 0; k < 20; ++k) (void)late.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
   s = late.step(observed(std::nullopt, at(away), 0.0), dt);
+  EXPECT_EQ(s.guard, Guard::BackThere);  // the origin is too long ago: the best view of the last 0.5 s is here
+  EXPECT_EQ(s.mode, LoopMode::Waiting);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
 }
