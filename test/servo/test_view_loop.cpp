@@ -347,6 +347,7 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
 // none of it from the origin.
 struct Post {
   Eigen::Vector3d on, off;
+  Proposer by = Proposer::None;  ///< whose view `on` is
   [[nodiscard]] bool goes() const { return (on - off).norm() < 1e-9; }
   /// Holds, or heads more than 45 deg off the way without the look-ahead.
   [[nodiscard]] bool turns_off() const {
@@ -362,6 +363,7 @@ Post with_a_post(double along, double side, bool t0_was_clear = false) {
   ViewProblem p = occluded_patch();
   p.occluders.conservativeResize(3, 10);
   p.occluders.col(9) = there + 0.05 * (object - there).normalized();
+  Proposer by = Proposer::None;
   const auto target = [&](bool look_ahead) {
     LoopSettings settings;
     settings.retreat.look_ahead = look_ahead;
@@ -369,9 +371,11 @@ Post with_a_post(double along, double side, bool t0_was_clear = false) {
     if (t0_was_clear) see_t0_clear(loop);
     const LoopStep s = loop.step(observed(p, vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);
     EXPECT_TRUE(s.target);
+    if (look_ahead) by = s.proposer;
     return s.target.value_or(Eigen::Vector3d::Constant(NAN));
   };
-  return {target(true), target(false)};
+  const Eigen::Vector3d on = target(true);
+  return {on, target(false), by};
 }
 
 TEST(ViewLoop, ItDoesNotGoWhereItsOwnMotionWouldHideTheObject) {
@@ -385,6 +389,8 @@ TEST(ViewLoop, ItDoesNotGoWhereItsOwnMotionWouldHideTheObject) {
   const Post blocked = with_a_post(0.025, 0.0);
   EXPECT_FALSE(blocked.goes());
   EXPECT_TRUE(blocked.turns_off());
+  EXPECT_TRUE(blocked.by == Proposer::Here || blocked.by == Proposer::Climb) << to_string(blocked.by);
+  EXPECT_NE(with_a_post(0.07, 0.0).by, Proposer::Here);
   EXPECT_TRUE(with_a_post(0.025, EIGEN_PI / 2).goes());
   EXPECT_TRUE(with_a_post(0.07, 0.0).goes());
   EXPECT_TRUE(with_a_post(0.025, 0.0, true).goes());
