@@ -108,7 +108,7 @@ class CommandLines {
   /// (id, position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
   void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,
              const LoopStep* step = nullptr) {
-    if (!out_) return;
+    if (!out_ || closed_) return;
     std::fprintf(out_, "{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
     for (unsigned i = 0; i < 6; ++i) std::fprintf(out_, "%s%.17g", i ? ", " : "", v[i]);
     std::fprintf(out_, "], \"safety\": \"%s\", ", safety);
@@ -127,6 +127,11 @@ class CommandLines {
     }
     std::fprintf(out_, "]}\n");
     std::fflush(out_);  // a line is readable as soon as its command is decided
+    if (std::ferror(out_)) {
+      // The reader went away (EPIPE: `| head`): stop as a signal does.
+      closed_ = true;
+      g_stop = 1;
+    }
     next_frame_ = frame + 1;
     last_t_ = t;
   }
@@ -136,7 +141,7 @@ class CommandLines {
   /// the stop line before the error is reported.
   void close() {
     if (!out_) return;
-    print(next_frame_, last_t_, "stop", vpColVector(6, 0.0), "");
+    print(next_frame_, last_t_, "stop", vpColVector(6, 0.0), "");  // nothing once the reader is gone
     std::fclose(out_);
     out_ = nullptr;
     std::cout.flush();
@@ -145,8 +150,12 @@ class CommandLines {
     ::close(saved_);
   }
 
+  /// Whether the reader of the lines went away (the run was stopped for it).
+  [[nodiscard]] bool reader_gone() const { return closed_; }
+
  private:
   std::FILE* out_ = nullptr;
+  bool closed_ = false;
   int saved_ = -1;
   long next_frame_ = 0;
   double last_t_ = 0.0;
@@ -200,6 +209,9 @@ Command add_run_command(CLI::App& app) {
             // driver) must end the run with a stop too, not kill it.
             std::signal(SIGINT, on_signal);
             std::signal(SIGTERM, on_signal);
+            // A closed output (`ofv run --dry-run | head`) is seen as a write
+            // error, which stops the run with the robot at rest, not a kill.
+            std::signal(SIGPIPE, SIG_IGN);
             const bool simulated = opt->source.rfind("sim:", 0) == 0;
             const bool real = opt->robot.size() > 5 && opt->robot.compare(opt->robot.size() - 5, 5, "-real") == 0;
             EpisodeSetup setup;
@@ -286,8 +298,12 @@ Command add_run_command(CLI::App& app) {
               if (simulated) {
                 const EpisodeOutcome outcome = rehearse(setup, &g_stop, print);
                 lines.close();
-                std::cout << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
-                          << (g_stop ? (user_quit ? ", stopped from the display" : ", stopped") : "") << '\n'
+                // The summary goes where the lines went, unless their reader is gone.
+                (lines.reader_gone() ? std::cerr : std::cout) << "ofv run: rehearsal of " << setup.scenario.name << " on the threaded " << to_string(setup.robot)
+                          << (g_stop ? (user_quit ? ", stopped from the display"
+                                        : lines.reader_gone() ? ", stopped: the output's reader went away" : ", stopped")
+                                     : "")
+                          << '\n'
                           << episode_summary(outcome.metrics);
                 return kOk;
               }
@@ -302,7 +318,11 @@ Command add_run_command(CLI::App& app) {
               const RobotLoopSummary summary = run_on_robot(*source, perception, *robot, setup.loop, options, print);
               lines.close();
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
-                        << (summary.stopped ? (user_quit ? ", stopped from the display" : ", stopped by a signal") : "") << '\n';
+                        << (summary.stopped ? (user_quit             ? ", stopped from the display"
+                                               : lines.reader_gone() ? ", stopped: the output's reader went away"
+                                                                     : ", stopped by a signal")
+                                            : "")
+                        << '\n';
               return kOk;
             } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims (after the stop line)
               std::cerr << "ofv run: " << e.what() << '\n';

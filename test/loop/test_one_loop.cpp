@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <vector>
 
@@ -196,6 +197,28 @@ TEST(OneLoop, RehearsalTracksTheScenariosObject) {
   ASSERT_EQ(automatic.code, 0) << automatic.err;
   EXPECT_LT(off_sphere_cm(labels), 6.0) << labels.out;
   EXPECT_GT(off_sphere_cm(automatic), 12.0) << automatic.out;
+}
+
+TEST(OneLoop, AClosedOutputStopsTheRunCleanly) {
+  // `ofv run --dry-run | head -1`: the reader goes away after one line; the
+  // next line fails (EPIPE, not a SIGPIPE kill), the run stops as on a
+  // signal, leaves the robot at rest and exits 0, saying why on stderr.
+  const std::string err = (fs::path(test::scratch_dir()) / "closed_output.err").string();
+  const std::string command = std::string("bash -c '") + OFV_BINARY +
+                              " run --robot afma6 --source sim:dvd-one-hand --set duration=30 --dry-run 2>" + err +
+                              " | head -1 >/dev/null; echo ${PIPESTATUS[0]}'";
+  const auto start = std::chrono::steady_clock::now();
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string status;
+  char buffer[256];
+  for (std::size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) status.append(buffer, n);
+  pclose(pipe);
+  EXPECT_EQ(status, "0\n");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 20.0);
+  std::ifstream in(err);
+  const std::string said((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(said.find("stopped: the output's reader went away"), std::string::npos) << said;
 }
 
 TEST(OneLoop, SignalsStopTheRobotAndEndTheRun) {
