@@ -315,8 +315,25 @@ Command add_run_command(CLI::App& app) {
               PerceptionSettings front_end = front_end_settings(setup);
               front_end.selection = selection;
               PerceptionObserver perception(front_end);
-              const RobotLoopSummary summary = run_on_robot(*source, perception, *robot, setup.loop, options, print);
+              // A --box or --rect that selects nothing in the first frame
+              // makes the run meaningless (every frame lost): stop and refuse.
+              std::string selects_nothing;
+              const auto first_frame = [&](const RobotLoopFrame& f) {
+                print(f);
+                if (f.index == 0 && selection.mode != ObjectSelection::Mode::Auto &&
+                    perception.last().status == TrackingStatus::Lost) {
+                  selects_nothing = (opt->box.empty() ? "--rect " + opt->rect : "--box " + opt->box) +
+                                    ": selects nothing in the first frame (" + perception.last().message + ")";
+                  g_stop = 1;
+                }
+              };
+              const RobotLoopSummary summary =
+                  run_on_robot(*source, perception, *robot, setup.loop, options, first_frame);
               lines.close();
+              if (!selects_nothing.empty()) {
+                std::cerr << "ofv run: " << selects_nothing << '\n';
+                return kUsage;
+              }
               std::cerr << "ofv run: " << summary.frames << " frames, object lost in " << summary.lost
                         << (summary.stopped ? (user_quit             ? ", stopped from the display"
                                                : lines.reader_gone() ? ", stopped: the output's reader went away"

@@ -132,7 +132,10 @@ TEST(OneLoop, RunTracksTheObjectThatABoxPointsOut) {
                                                              {" --box 0,0,0,1,1,nan", "--box"},
                                                              {" --rect 0,0,10.5,10", "--rect"},
                                                              {" --box 0,0,0,1,1,1 --rect 0,0,10,10", "--rect"},
-                                                             {" --set select=auto", "select"}};
+                                                             {" --set select=auto", "select"},
+                                                             // nothing of the first frame inside
+                                                             {" --box 2,2,2,3,3,3", "selects nothing"},
+                                                             {" --rect 0,0,2,2", "selects nothing"}};
   for (const auto& [options, named] : bad) {
     const CommandRun r = run(source + options);
     EXPECT_EQ(r.code, 2) << options;
