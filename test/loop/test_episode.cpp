@@ -189,6 +189,15 @@ TEST(Episode, SettingsAreValidatedByName) {
       EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
     }
   }
+  // Valid one by one, meaningless together: at 30 Hz, 8 frames of latency
+  // make every command older than the 0.2 s stale timeout.
+  try {
+    (void)resolve_episode(s, {{"latency", "8"}});
+    ADD_FAILURE() << "latency=8 with stale_timeout=0.2 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("stale_timeout"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW((void)resolve_episode(s, {{"latency", "8"}, {"stale_timeout", "0.5"}}));
   // Lengths may refer to the scenario's radii.
   const EpisodeSetup r = resolve_episode(s, {{"push_radius", "r_seed"}});
   EXPECT_DOUBLE_EQ(r.loop.estimator.resolve().push_radius, 0.02);
@@ -229,6 +238,11 @@ TEST(Episode, EveryNumericSettingDocumentsTheRangeItChecks) {
   const sim::Scenario scenario = sim::load_scenario(kOnRay);
   const auto accepted = [&](const std::string& name, const std::string& value) {
     try {
+      // A long latency needs a stale timeout that its frames stay within.
+      if (name == "latency") {
+        (void)resolve_episode(scenario, {{"stale_timeout", "60"}, {name, value}});
+        return true;
+      }
       (void)resolve_episode(scenario, {{name, value}});
       return true;
     } catch (const std::invalid_argument&) {

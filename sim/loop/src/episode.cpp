@@ -57,7 +57,8 @@ SettingsTable<EpisodeSetup> make_table() {
         [](E& e, const std::string& v) { e.seed = static_cast<unsigned>(parse_integer("seed", v, 0, 1000000000)); },
         [](const E& e) { return std::to_string(e.seed); });
   t.add({"latency", "integer in [0, 30]", std::to_string(d.latency), "frames",
-         "delay between capturing a frame and applying its command (simulation), 0 to 30"},
+         "delay between capturing a frame and applying its command (simulation), 0 to 30; (1 + latency) / rate must "
+         "stay within stale_timeout"},
         [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); },
         [](const E& e) { return std::to_string(e.latency); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
@@ -210,6 +211,16 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
   episode_settings_table().apply(s, settings);
   s.scenario = sim::with_seed(scenario, s.seed);
   (void)ViewLoop(s.loop);  // validates every loop setting
+  // Valid one by one, meaningless together: every frame older than the
+  // stale timeout when its command is sent, the robot would never move.
+  const double age = (1.0 + s.latency) / s.scenario.rate;
+  if (!s.real_time && age > s.loop.safety.stale_timeout) {
+    throw std::invalid_argument("settings latency = " + std::to_string(s.latency) + " and stale_timeout = " +
+                                format_number(s.loop.safety.stale_timeout) + " s: at " + format_number(s.scenario.rate) +
+                                " Hz every frame is " + format_number(age) +
+                                " s old when its command is sent, older than stale_timeout, and the robot would "
+                                "never move; lower latency or raise stale_timeout");
+  }
   if (s.real_time && s.robot == RobotKind::Camera) {
     throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");
   }
