@@ -183,7 +183,8 @@ Command add_run_command(CLI::App& app) {
                   "Frames: TUM folder, PCD sequence, FILE.oni, openni2://URI, or sim:SCENARIO (the scenario rendered "
                   "live from the simulated arm's camera: a rehearsal without hardware)")
       ->required();
-  sub->add_option("--emc", opt->emc, "File with the camera-end-effector transform eMc: tx ty tz tux tuy tuz");
+  sub->add_option("--emc", opt->emc,
+                  "File with the camera-end-effector transform eMc: tx ty tz tux tuy tuz (real robot drivers only)");
   sub->add_option("--set", opt->sets, "Any setting of 'ofv simulate' as name=value (repeatable), same defaults")
       ->type_name("NAME=VALUE");
   add_selection_options(*sub, opt->box, opt->rect);
@@ -245,6 +246,10 @@ Command add_run_command(CLI::App& app) {
                 }
 #endif
               };
+              if (!opt->emc.empty() && !real) {
+                throw std::invalid_argument("--emc: the camera-end-effector transform is for a real robot driver (" +
+                                            real_drivers() + "); --robot " + opt->robot + " carries its camera itself");
+              }
               if (simulated) {
                 if (!opt->box.empty() || !opt->rect.empty()) {
                   throw std::invalid_argument(

@@ -142,6 +142,11 @@ TEST(OneLoop, RunTracksTheObjectThatABoxPointsOut) {
     EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
   }
   EXPECT_EQ(run("run --robot viper850 --source sim:dvd-one-hand --box 0,0,0,1,1,1").code, 2);
+  // A calibration a simulated robot would ignore.
+  const CommandRun emc = run("run --robot viper850 --source sim:dvd-one-hand --emc /dev/null");
+  EXPECT_EQ(emc.code, 2);
+  EXPECT_NE(emc.err.find("--emc"), std::string::npos) << emc.err;
+  EXPECT_EQ(run(source + " --emc /dev/null").code, 2);
 }
 
 TEST(OneLoop, RehearsalRunsInWallClockTimeOnTheThreadedArm) {
