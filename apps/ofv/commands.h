@@ -45,6 +45,12 @@ Command add_render_command(CLI::App& app);
 /// Every setting of the closed loop (`ofv simulate`, `ofv run`), for their help.
 std::string episode_settings_help();
 
+/// \throws std::invalid_argument when a `--set name=...` gives setting `name`
+/// another value than `flag` (given, with `value`) does: one of them would be
+/// ignored. A flag not given (`given` false) leaves --set free.
+void refuse_set_against_flag(const std::vector<std::pair<std::string, std::string>>& sets, const std::string& name,
+                             const std::string& flag, bool given, const std::string& value);
+
 /// Registers `ofv simulate` (the closed loop in simulation) on the app.
 Command add_simulate_command(CLI::App& app);
 

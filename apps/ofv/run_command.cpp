@@ -175,7 +175,7 @@ Command add_run_command(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("run", "Run the closed loop on a robot and a sensor, a recording, or a live simulation");
-  sub->add_option("--robot", opt->robot,
+  CLI::Option* robot_flag = sub->add_option("--robot", opt->robot,
                   "camera, viper850, afma6 (ViSP's kinematic models; with a sim: source, ViSP's threaded simulators), "
                   "or a real driver: " + real_drivers())
       ->capture_default_str();
@@ -205,7 +205,7 @@ Command add_run_command(CLI::App& app) {
               "run's lines are flushed one by one; the last one is always the stop.\n\n" +
               episode_settings_help());
 
-  return {sub, [opt]() -> int {
+  return {sub, [opt, robot_flag]() -> int {
             // First: a signal during start-up (loading a scenario, starting a
             // driver) must end the run with a stop too, not kill it.
             std::signal(SIGINT, on_signal);
@@ -225,6 +225,7 @@ Command add_run_command(CLI::App& app) {
             try {
               std::vector<std::pair<std::string, std::string>> settings;
               for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
+              refuse_set_against_flag(settings, "robot", "--robot", robot_flag->count() > 0, opt->robot);
               if (!real) settings.insert(settings.begin(), {"robot", opt->robot});
               // The windows open once the settings are valid, before a driver
               // starts or a source opens: no display is an error at start.

@@ -29,6 +29,17 @@ std::string episode_settings_help() {
          settings_help(episode_settings_table().docs());
 }
 
+void refuse_set_against_flag(const std::vector<std::pair<std::string, std::string>>& sets, const std::string& name,
+                             const std::string& flag, bool given, const std::string& value) {
+  if (!given) return;
+  for (const auto& [k, v] : sets) {
+    if (k == name && v != value) {
+      throw std::invalid_argument("--set " + k + "=" + v + " and " + flag + " " + value +
+                                  " set the same setting to different values: give one");
+    }
+  }
+}
+
 Command add_simulate_command(CLI::App& app) {
   struct Options {
     std::string scenario = sim::kDefaultScenario;
@@ -51,7 +62,7 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_option("--set", opt->sets, "Override a setting: name=value (repeatable; the settings are listed below)")
       ->type_name("NAME=VALUE");
   sub->add_option("--perception", opt->perception, "full (the front end, default), labels (the same with the rendered labels in place of segmentation and classification) or ground-truth (the simulator's supervoxels and every occluder in the sphere)");
-  sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
+  CLI::Option* seed_flag = sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
   sub->add_option("--out", opt->out, "Output folder (default: out/simulate/SCENARIO)");
   sub->add_flag("!--no-pictures", opt->pictures, "Skip the PNG pictures");
   sub->add_option("--record", opt->record,
@@ -85,7 +96,7 @@ Command add_simulate_command(CLI::App& app) {
               "scene views at the start, when an occluder enters the sphere or the visibility falls below 0.9, 1 s later "
               "and at the end; visibility.png); with --video, episode.avi.\n\n" + episode_settings_help());
 
-  return {sub, [opt]() -> int {
+  return {sub, [opt, seed_flag]() -> int {
             EpisodeSetup setup;
 #if defined(OFV_HAVE_DISPLAY)
             std::unique_ptr<LiveDisplay> display;
@@ -97,7 +108,13 @@ Command add_simulate_command(CLI::App& app) {
               if (opt->real_time) settings.emplace_back("real_time", "true");
               if (!opt->perception.empty()) settings.emplace_back("perception", opt->perception);
               settings.emplace_back("seed", std::to_string(opt->seed));
-              for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
+              std::vector<std::pair<std::string, std::string>> sets;
+              for (const auto& a : opt->sets) sets.push_back(split_assignment(a));
+              refuse_set_against_flag(sets, "robot", "--robot", !opt->robot.empty(), opt->robot);
+              refuse_set_against_flag(sets, "perception", "--perception", !opt->perception.empty(), opt->perception);
+              refuse_set_against_flag(sets, "seed", "--seed", seed_flag->count() > 0, std::to_string(opt->seed));
+              refuse_set_against_flag(sets, "real_time", "--real-time", opt->real_time, "true");
+              settings.insert(settings.end(), sets.begin(), sets.end());
               setup = resolve_episode(scenario, settings);
 #if defined(OFV_HAVE_DISPLAY)
               if (opt->display) {

@@ -135,13 +135,22 @@ TEST(OneLoop, RunTracksTheObjectThatABoxPointsOut) {
                                                              {" --set select=auto", "select"},
                                                              // nothing of the first frame inside
                                                              {" --box 2,2,2,3,3,3", "selects nothing"},
-                                                             {" --rect 0,0,2,2", "selects nothing"}};
+                                                             {" --rect 0,0,2,2", "selects nothing"},
+                                                             // a flag and a --set of the same setting
+                                                             {" --set robot=viper850", "--robot"}};
   for (const auto& [options, named] : bad) {
     const CommandRun r = run(source + options);
     EXPECT_EQ(r.code, 2) << options;
     EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
   }
   EXPECT_EQ(run("run --robot viper850 --source sim:dvd-one-hand --box 0,0,0,1,1,1").code, 2);
+  // A flag and a --set that give one setting two values: one would be ignored.
+  for (const char* both : {"simulate dvd-static --seed 1 --set seed=2", "simulate dvd-static --robot camera --set robot=afma6",
+                           "simulate dvd-static --perception labels --set perception=full"}) {
+    const CommandRun r = run(both);
+    EXPECT_EQ(r.code, 2) << both;
+    EXPECT_NE(r.err.find("give one"), std::string::npos) << both << ": " << r.err;
+  }
   // A calibration a simulated robot would ignore.
   const CommandRun emc = run("run --robot viper850 --source sim:dvd-one-hand --emc /dev/null");
   EXPECT_EQ(emc.code, 2);
