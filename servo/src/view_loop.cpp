@@ -655,8 +655,7 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
     out.presumed_occluders = problem->occluders.cols() - seen;
   }
   // The world model, once per frame: the tracks of the occluders seen.
-  const Eigen::Matrix3Xd seen_occluders = problem ? Eigen::Matrix3Xd(problem->occluders.leftCols(seen)) : Eigen::Matrix3Xd();
-  out.tracks = world.update(problem ? &seen_occluders : nullptr, dt);
+  out.tracks = world.update(observation.problem ? &observation.problem->occluders : nullptr, dt);
 
   // The retreat's modes need the estimator, a known shown area and retreat_drop > 0.
   const bool retreat = settings.method == ViewMethod::Estimator && settings.retreat.drop > 0.0;
