@@ -38,8 +38,11 @@ cv::Mat camera_picture(const StepRecord& rec, const StepDetail& d) {
   }
   std::ostringstream text;
   text << std::fixed << std::setprecision(2) << "t=" << rec.time << "s  visible " << rec.visible_fraction
-       << "  " << to_string(rec.status) << "  " << to_string(rec.mode) << " (" << to_string(rec.proposer) << ")";
+       << "  " << to_string(rec.status);
   cv::putText(img, text.str(), {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {255, 255, 255}, 1, cv::LINE_AA);
+  // The policy's decision on a line of its own: a 320-pixel image has no room beside the rest.
+  const std::string decision = std::string(to_string(rec.mode)) + " (" + to_string(rec.proposer) + ")";
+  cv::putText(img, decision, {6, 32}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {255, 255, 255}, 1, cv::LINE_AA);
   return img;
 }
 
