@@ -40,34 +40,35 @@ constexpr double kMinNormal = 1e-12;        // §7: shorter normals are invalid
 // ---------------------------------------------------------------------------
 // Inputs and §7: what the estimator may use.
 
-// §7 parameters and the optional inputs: these are usage errors, thrown before
+void require_finite(const char* name, const std::optional<Eigen::Vector3d>& p) {
+  if (p && !p->allFinite()) {
+    usage_error(std::string("'") + name + "' must be finite, got " + format_value(*p));
+  }
+}
+
+// Extreme but finite coordinates (non-finite ones are §7's to skip).
+void require_in_range(const std::string& name, const Eigen::Matrix3Xd& m) {
+  for (Eigen::Index k = 0; k < m.cols(); ++k) {
+    for (int i = 0; i < 3; ++i) {
+      if (std::isfinite(m(i, k)) && std::abs(m(i, k)) > kMaxLength) {
+        usage_error(name + " " + std::to_string(k) + " has a coordinate beyond " + format_value(kMaxLength) +
+                    " m: " + format_value(Eigen::Vector3d(m.col(k))));
+      }
+    }
+  }
+}
+
+// The optional inputs and §7's hygiene: these are usage errors, thrown before
 // any work so that a bad frame never half-succeeds.
-void check_inputs(const ViewProblem& problem, const EstimatorSettings& settings) {
-  validate(settings);
+void check_problem(const ViewProblem& problem) {
   if (problem.positions.cols() != problem.normals.cols()) {
     usage_error("supervoxel positions (" + std::to_string(problem.positions.cols()) +
                 ") and normals (" + std::to_string(problem.normals.cols()) +
                 ") differ in number");
   }
-  const auto require_finite = [](const char* name, const std::optional<Eigen::Vector3d>& p) {
-    if (p && !p->allFinite()) {
-      usage_error(std::string("'") + name + "' must be finite, got " + format_value(*p));
-    }
-  };
   require_finite("centroid", problem.centroid);
   require_finite("camera", problem.camera);
   require_finite("previous_view", problem.previous_view);
-  // Extreme but finite coordinates (non-finite ones are §7's to skip).
-  const auto require_in_range = [](const std::string& name, const Eigen::Matrix3Xd& m) {
-    for (Eigen::Index k = 0; k < m.cols(); ++k) {
-      for (int i = 0; i < 3; ++i) {
-        if (std::isfinite(m(i, k)) && std::abs(m(i, k)) > kMaxLength) {
-          usage_error(name + " " + std::to_string(k) + " has a coordinate beyond " + format_value(kMaxLength) +
-                      " m: " + format_value(Eigen::Vector3d(m.col(k))));
-        }
-      }
-    }
-  };
   require_in_range("supervoxel position", problem.positions);
   require_in_range("supervoxel normal", problem.normals);
   require_in_range("occluder", problem.occluders);
@@ -131,19 +132,6 @@ Eigen::Matrix3Xd usable_occluders(const Eigen::Matrix3Xd& occluders) {
   return q;
 }
 
-// No usable supervoxel and no C given: nothing to look at. The camera stays
-// where it is (t0 = tf = camera, or zero without one).
-ViewEstimate no_supervoxels(const ViewProblem& problem) {
-  ViewEstimate est;
-  est.status = ViewStatus::NoSupervoxels;
-  est.t0 = est.tf = problem.camera.value_or(Eigen::Vector3d::Zero());
-  est.iterations = 0;
-  est.skipped_supervoxels = static_cast<int>(problem.positions.cols());
-  est.skipped_occluders =
-      static_cast<int>(problem.occluders.cols() - usable_occluders(problem.occluders).cols());
-  return est;
-}
-
 // C and the object axes e1, e2, e3 (columns of e).
 struct ObjectFrame {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
@@ -197,34 +185,27 @@ ObjectFrame object_frame(const ViewProblem& problem, const Eigen::Matrix3Xd& poi
 // ---------------------------------------------------------------------------
 // §1: normals-to-sphere rays (eq. 3).
 
-// The supervoxels inside the sphere and their rays u_n = s_n - C.
-struct NormalRays {
-  Eigen::Matrix3Xd v;  // v_n of the supervoxels kept
-  Eigen::Matrix3Xd p;  // their unit normals p_n
-  Eigen::Matrix3Xd u;  // s_n - C
-  [[nodiscard]] Eigen::Index size() const { return v.cols(); }
-};
-
 // §1: s_n is where v_n + t p_n, t > 0, leaves the sphere; supervoxels at or
 // outside the sphere (|v_n - C| >= R) have no ray and are skipped.
-NormalRays normals_to_sphere_rays(const Supervoxels& s, const Eigen::Vector3d& c, double r) {
-  NormalRays rays;
-  rays.v.resize(3, s.size());
-  rays.p.resize(3, s.size());
-  rays.u.resize(3, s.size());
+// The rays u_n = s_n - C of the supervoxels kept, no occluders yet.
+UsableInput normals_to_sphere_rays(const Supervoxels& s, const Eigen::Vector3d& c, double r) {
+  UsableInput rays;
+  rays.positions.resize(3, s.size());
+  rays.normals.resize(3, s.size());
+  rays.rays.resize(3, s.size());
   Eigen::Index n = 0;
   for (Eigen::Index k = 0; k < s.size(); ++k) {
     if (!((s.v.col(k) - c).norm() < r)) {
       continue;
     }
-    rays.v.col(n) = s.v.col(k);
-    rays.p.col(n) = s.p.col(k);
-    rays.u.col(n) = sphere_exit(c, r, s.v.col(k), s.p.col(k)) - c;
+    rays.positions.col(n) = s.v.col(k);
+    rays.normals.col(n) = s.p.col(k);
+    rays.rays.col(n) = sphere_exit(c, r, s.v.col(k), s.p.col(k)) - c;
     ++n;
   }
-  rays.v.conservativeResize(3, n);
-  rays.p.conservativeResize(3, n);
-  rays.u.conservativeResize(3, n);
+  rays.positions.conservativeResize(3, n);
+  rays.normals.conservativeResize(3, n);
+  rays.rays.conservativeResize(3, n);
   return rays;
 }
 
@@ -297,17 +278,17 @@ struct InitialViewChoice {
 // §2: t0 = C + R dir, dir from the chosen rule, falling back from
 // spherical_mean (needs e1 determined and N > 0) to vector_mean (N > 0) to
 // the camera.
-InitialViewChoice initial_view(const NormalRays& rays, const ObjectFrame& object,
+InitialViewChoice initial_view(const Eigen::Matrix3Xd& u, const ObjectFrame& object,
                                const std::optional<Eigen::Vector3d>& camera, double r,
                                InitialView rule) {
   const Eigen::Vector3d& c = object.c;
-  if (rule == InitialView::SphericalMean && object.determined && rays.size() > 0) {
-    if (const auto dir = spherical_mean_direction(rays.u, object.e)) {
+  if (rule == InitialView::SphericalMean && object.determined && u.cols() > 0) {
+    if (const auto dir = spherical_mean_direction(u, object.e)) {
       return {c + r * *dir, InitialViewUsed::SphericalMean};
     }
   }
-  if (rays.size() > 0) {
-    if (const auto dir = vector_mean_direction(rays.u)) {
+  if (u.cols() > 0) {
+    if (const auto dir = vector_mean_direction(u)) {
       return {c + r * *dir, InitialViewUsed::VectorMean};
     }
   }
@@ -512,54 +493,17 @@ OcclusionRays occlusion_rays(const Eigen::Vector3d& c, double r, const Eigen::Ma
   return rays;
 }
 
-// The last occlusion rays computed on this thread, with their inputs: a
-// loop that estimates the same problem again from another start (the warm
-// start from its previous target) gets them without computing them twice.
-// Only problems of up to kCachedRays points are kept (memory held per thread).
-class RaysCache {
- public:
-  // The thread's BufferCache first, so that it outlives this cache (thread
-  // storage is destroyed in reverse order) and takes back the rays' buffer.
-  RaysCache() { (void)buffer_cache(); }
-
-  const OcclusionRays& get(const Eigen::Vector3d& c, double r, const Eigen::Matrix3Xd& v,
-                           const Eigen::Matrix3Xd& q) {
-    const bool same = valid_ && c == c_ && r == r_ && v.cols() == v_.cols() && q.cols() == q_.cols() &&
-                      v == v_ && q == q_;
-    if (!same) {
-      valid_ = false;
-      rays_.reset();  // its buffer back to the cache first
-      rays_.emplace(occlusion_rays(c, r, v, q));
-      if (static_cast<double>(v.cols()) * static_cast<double>(q.cols()) <= kCachedRays) {
-        c_ = c;
-        r_ = r;
-        v_ = v;
-        q_ = q;
-        valid_ = true;
-      }
-    }
-    return *rays_;
-  }
-
- private:
-  static constexpr double kCachedRays = 1e6;
-  bool valid_ = false;
-  Eigen::Vector3d c_ = Eigen::Vector3d::Zero();
-  double r_ = 0.0;
-  Eigen::Matrix3Xd v_, q_;
-  std::optional<OcclusionRays> rays_;
-};
-
 // ---------------------------------------------------------------------------
 // §4: the iteration (eqs. 6-8).
 
 // §4 `warm_start`: C + R unit(previous_view - C) when on and given, else t0.
-Eigen::Vector3d iteration_start(const ViewProblem& problem, const EstimatorSettings& settings,
-                                const Eigen::Vector3d& c, const Eigen::Vector3d& t0) {
-  if (!settings.warm_start || !problem.previous_view) {
+Eigen::Vector3d iteration_start(const std::optional<Eigen::Vector3d>& previous_view,
+                                const EstimatorSettings& settings, const Eigen::Vector3d& c,
+                                const Eigen::Vector3d& t0) {
+  if (!settings.warm_start || !previous_view) {
     return t0;
   }
-  const Eigen::Vector3d from_c = *problem.previous_view - c;
+  const Eigen::Vector3d from_c = *previous_view - c;
   if (from_c.norm() < kCameraEps) {
     usage_error("'previous_view' is at the centroid: no direction to warm-start from");
   }
@@ -932,57 +876,108 @@ Eigen::Vector3d sphere_exit(const Eigen::Vector3d& centre, double radius,
   return origin + t * u;
 }
 
-ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& settings,
-                           const EstimateOptions& options) {
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(settings.time_budget));
-  check_inputs(problem, settings);
-  const double r = settings.r_sphere;
+struct OcclusionField::Data {
+  double r = 0.0;
+  std::optional<Eigen::Vector3d> camera;
+  bool has_object = false;
+  ObjectFrame object;
+  UsableInput usable;  // §1's rays and §7's occluders
+  int skipped_supervoxels = 0;
+  int skipped_occluders = 0;
+  std::optional<OcclusionRays> occlusion;  // §3, none without occluders
+};
 
+OcclusionField::OcclusionField(const ViewProblem& problem, double r_sphere) : data_(std::make_unique<Data>()) {
+  if (!(r_sphere > 0.0) || !std::isfinite(r_sphere)) {
+    usage_error("r_sphere must be finite and > 0, got " + format_value(r_sphere));
+  }
+  check_problem(problem);
+  Data& d = *data_;
+  d.r = r_sphere;
+  d.camera = problem.camera;
   // Inputs, §7: C and the axes describe the whole object, so they come from
   // every usable supervoxel, also those §1 then skips for lying at or outside
   // the sphere (which is judged against this C).
   const Supervoxels supervoxels = usable_supervoxels(problem);
-  if (!problem.centroid && supervoxels.size() == 0) {
-    return no_supervoxels(problem);
+  d.has_object = problem.centroid || supervoxels.size() > 0;
+  d.usable.occluders = usable_occluders(problem.occluders);
+  d.skipped_occluders = static_cast<int>(problem.occluders.cols() - d.usable.occluders.cols());
+  if (!d.has_object) {
+    d.skipped_supervoxels = static_cast<int>(problem.positions.cols());
+    return;
   }
-  const ObjectFrame object = object_frame(problem, supervoxels.v);
-  const Eigen::Vector3d& c = object.c;
-  ViewEstimate est;
-  est.centroid = c;
-  est.axes = object.e;
-  est.axes_from_world = object.from_world;
-
+  d.object = object_frame(problem, supervoxels.v);
   // §1: normals-to-sphere rays.
-  const NormalRays rays = normals_to_sphere_rays(supervoxels, c, r);
-  est.skipped_supervoxels = static_cast<int>(problem.positions.cols() - rays.size());
+  d.usable = normals_to_sphere_rays(supervoxels, d.object.c, r_sphere);
+  d.usable.occluders = usable_occluders(problem.occluders);
+  d.skipped_supervoxels = static_cast<int>(problem.positions.cols() - d.usable.positions.cols());
+  // §3: occlusion-to-sphere rays.
+  const Eigen::Index n_v = d.usable.positions.cols();
+  const Eigen::Index n_q = d.usable.occluders.cols();
+  const double n_rays = static_cast<double>(n_v) * static_cast<double>(n_q);
+  if (n_rays > kMaxOcclusionRays) {
+    usage_error(std::to_string(n_v) + " supervoxels x " + std::to_string(n_q) + " occluders make " +
+                format_value(n_rays) + " occlusion rays, more than the " + format_value(kMaxOcclusionRays) +
+                " ofv handles: thin the supervoxels or the occluders");
+  }
+  if (n_q > 0) d.occlusion.emplace(occlusion_rays(d.object.c, r_sphere, d.usable.positions, d.usable.occluders));
+}
+
+OcclusionField::~OcclusionField() = default;
+OcclusionField::OcclusionField(OcclusionField&&) noexcept = default;
+OcclusionField& OcclusionField::operator=(OcclusionField&&) noexcept = default;
+double OcclusionField::r_sphere() const { return data_->r; }
+bool OcclusionField::has_object() const { return data_->has_object; }
+const Eigen::Vector3d& OcclusionField::centroid() const { return data_->object.c; }
+const UsableInput& OcclusionField::usable() const { return data_->usable; }
+int OcclusionField::occlusion_points() const { return data_->occlusion ? static_cast<int>(data_->occlusion->size()) : 0; }
+
+namespace detail {
+
+struct FieldAccess {
+  static const OcclusionField::Data& data(const OcclusionField& field) { return *field.data_; }
+};
+
+}  // namespace detail
+
+namespace {
+
+ViewEstimate estimate_on(const OcclusionField& field, const EstimatorSettings& settings,
+                         const std::optional<Eigen::Vector3d>& previous_view, const EstimateOptions& options,
+                         Clock::time_point deadline) {
+  const auto& d = detail::FieldAccess::data(field);
+  ViewEstimate est;
+  est.skipped_supervoxels = d.skipped_supervoxels;
+  est.skipped_occluders = d.skipped_occluders;
+  if (!d.has_object) {
+    // No usable supervoxel and no C given: nothing to look at. The camera
+    // stays where it is (t0 = tf = camera, or zero without one).
+    est.status = ViewStatus::NoSupervoxels;
+    est.t0 = est.tf = d.camera.value_or(Eigen::Vector3d::Zero());
+    return est;
+  }
+  const double r = settings.r_sphere;
+  const Eigen::Vector3d& c = d.object.c;
+  est.centroid = c;
+  est.axes = d.object.e;
+  est.axes_from_world = d.object.from_world;
+  const Eigen::Matrix3Xd& u = d.usable.rays;
 
   // §2: initial view t0.
-  const InitialViewChoice initial =
-      initial_view(rays, object, problem.camera, r, settings.initial_view);
+  const InitialViewChoice initial = initial_view(u, d.object, d.camera, r, settings.initial_view);
   est.t0 = initial.t0;
   est.initial_view_used = initial.used;
 
-  // §3, §4: occlusion rays and the iteration.
-  const Eigen::Matrix3Xd q = usable_occluders(problem.occluders);
-  est.skipped_occluders = static_cast<int>(problem.occluders.cols() - q.cols());
-  const Eigen::Vector3d start = iteration_start(problem, settings, c, est.t0);
-  if (q.cols() == 0) {
+  // §4: the iteration.
+  const Eigen::Vector3d start = iteration_start(previous_view, settings, c, est.t0);
+  if (d.usable.occluders.cols() == 0) {
     est.status = ViewStatus::NoOccluders;
     est.tf = est.t0;
     if (options.record_path) est.path.push_back(est.t0);
   } else {
-    const double n_rays = static_cast<double>(rays.v.cols()) * static_cast<double>(q.cols());
-    if (n_rays > kMaxOcclusionRays) {
-      usage_error(std::to_string(rays.v.cols()) + " supervoxels x " + std::to_string(q.cols()) +
-                  " occluders make " + format_value(n_rays) + " occlusion rays, more than the " +
-                  format_value(kMaxOcclusionRays) + " ofv handles: thin the supervoxels or the occluders");
-    }
-    thread_local RaysCache cache;
-    const OcclusionRays& occ = cache.get(c, r, rays.v, q);
-    est.occlusion_points = static_cast<int>(occ.size());
+    est.occlusion_points = static_cast<int>(d.occlusion->size());
     const IterationResult it =
-        iterate(occ, start, est.t0, object, settings, deadline, options.record_path ? &est.path : nullptr);
+        iterate(*d.occlusion, start, est.t0, d.object, settings, deadline, options.record_path ? &est.path : nullptr);
     est.tf = it.tf;
     est.status = it.status;
     est.iterations = it.iterations;
@@ -990,8 +985,8 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   }
 
   // §6: angular errors.
-  est.error_t0 = angular_error(rays.u, est.t0 - c);
-  est.error_tf = angular_error(rays.u, est.tf - c);
+  est.error_t0 = angular_error(u, est.t0 - c);
+  est.error_tf = angular_error(u, est.tf - c);
   est.tf_to_t0_deg = angle_between(est.tf - c, est.t0 - c) * kRadToDeg;
   // Geometry never lies: a view is finite and on the sphere.
   for (const Eigen::Vector3d* t : {&est.t0, &est.tf}) {
@@ -1003,14 +998,43 @@ ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& 
   return est;
 }
 
+Clock::time_point deadline_after(const EstimatorSettings& settings) {
+  return Clock::now() +
+         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(settings.time_budget));
+}
+
+}  // namespace
+
+ViewEstimate estimate_view(const OcclusionField& field, const EstimatorSettings& settings,
+                           const std::optional<Eigen::Vector3d>& previous_view, const EstimateOptions& options) {
+  const Clock::time_point deadline = deadline_after(settings);
+  validate(settings);
+  if (settings.r_sphere != field.r_sphere()) {
+    usage_error("r_sphere " + format_value(settings.r_sphere) + " differs from the occlusion field's " +
+                format_value(field.r_sphere()));
+  }
+  require_finite("previous_view", previous_view);
+  if (previous_view) require_in_range("previous_view", *previous_view);
+  return estimate_on(field, settings, previous_view, options, deadline);
+}
+
+ViewEstimate estimate_view(const ViewProblem& problem, const EstimatorSettings& settings,
+                           const EstimateOptions& options) {
+  const Clock::time_point deadline = deadline_after(settings);
+  validate(settings);
+  const OcclusionField field(problem, settings.r_sphere);
+  return estimate_on(field, settings, problem.previous_view, options, deadline);
+}
+
 void reserve_estimator_memory(std::size_t occlusion_points) {
   const std::size_t rows = (std::min(occlusion_points, kMaxKeptPoints) + kLanes - 1) / kLanes;
   buffer_cache().reserve(3 * rows * kLanes);
 }
 
 UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere) {
-  const NormalRays rays = normals_to_sphere_rays(usable_supervoxels(problem), centroid, r_sphere);
-  return {rays.v, rays.p, rays.u, usable_occluders(problem.occluders)};
+  UsableInput input = normals_to_sphere_rays(usable_supervoxels(problem), centroid, r_sphere);
+  input.occluders = usable_occluders(problem.occluders);
+  return input;
 }
 
 }  // namespace ofv

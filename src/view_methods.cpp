@@ -74,6 +74,56 @@ ScoredView score(const UsableInput& u, const Eigen::Vector3d& c,
   return s;
 }
 
+ScoredView sample_best(const UsableInput& u, const Eigen::Vector3d& centroid, double r_sphere,
+                       const SamplingSettings& sampling) {
+  if (!(sampling.occluder_radius > 0.0) || !std::isfinite(sampling.occluder_radius)) {
+    throw std::invalid_argument("sampling occluder_radius must be finite and positive");
+  }
+  const Eigen::Matrix3Xd dirs = fibonacci_directions(sampling.candidates);
+  ScoredView best;
+  best.visible_fraction = -1.0;
+  for (Eigen::Index k = 0; k < dirs.cols(); ++k) {
+    const ScoredView s =
+        score(u, centroid, centroid + r_sphere * dirs.col(k), sampling.occluder_radius);
+    if (s.visible_fraction > best.visible_fraction ||
+        (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
+      best = s;
+    }
+  }
+  return best;
+}
+
+ScoredView most_visible(const UsableInput& u, const Eigen::Vector3d& centroid, double r_sphere,
+                        const Eigen::Vector3d& current, const std::vector<Eigen::Vector3d>& others,
+                        const MostVisibleSettings& settings) {
+  const auto on_sphere = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    const Eigen::Vector3d d = p - centroid;
+    return d.norm() > 1e-12 ? Eigen::Vector3d(centroid + r_sphere * d.normalized()) : centroid + r_sphere * Eigen::Vector3d::UnitZ();
+  };
+  const Eigen::Vector3d here = on_sphere(current);
+  const ScoredView held = score(u, centroid, here, settings.occluder_radius);
+  ScoredView best = held;
+  const auto consider = [&](const Eigen::Vector3d& view) {
+    const ScoredView s = score(u, centroid, on_sphere(view), settings.occluder_radius);
+    if (s.visible_fraction > best.visible_fraction ||
+        (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
+      best = s;
+    }
+  };
+  // Eight neighbours: rotate `here` about two tangent axes by step_deg.
+  const Eigen::Vector3d w = (here - centroid).normalized();
+  const Eigen::Vector3d a = w.unitOrthogonal();
+  const Eigen::Vector3d b = w.cross(a);
+  const double step = settings.step_deg * kPi / 180.0;
+  for (int k = 0; k < 8; ++k) {
+    const double phi = kPi / 4.0 * k;
+    const Eigen::Vector3d tangent = std::cos(phi) * a + std::sin(phi) * b;
+    consider(centroid + r_sphere * (std::cos(step) * w + std::sin(step) * tangent));
+  }
+  for (const Eigen::Vector3d& o : others) consider(o);
+  return best.visible_fraction >= held.visible_fraction + settings.margin ? best : held;
+}
+
 }  // namespace
 
 const char* to_string(ViewMethod m) {
@@ -104,6 +154,10 @@ ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroi
   return score(usable_input(problem, centroid, r_sphere), centroid, view, occluder_radius);
 }
 
+ScoredView score_view(const OcclusionField& field, const Eigen::Vector3d& view, double occluder_radius) {
+  return score(field.usable(), field.centroid(), view, occluder_radius);
+}
+
 double mean_angular_error_deg(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
                               const Eigen::Vector3d& view) {
   return mean_error_deg(usable_input(problem, centroid, r_sphere), centroid, view);
@@ -111,54 +165,22 @@ double mean_angular_error_deg(const ViewProblem& problem, const Eigen::Vector3d&
 
 ScoredView sample_best_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                             double r_sphere, const SamplingSettings& sampling) {
-  if (!(sampling.occluder_radius > 0.0) || !std::isfinite(sampling.occluder_radius)) {
-    throw std::invalid_argument("sampling occluder_radius must be finite and positive");
-  }
-  const UsableInput u = usable_input(problem, centroid, r_sphere);
-  const Eigen::Matrix3Xd dirs = fibonacci_directions(sampling.candidates);
-  ScoredView best;
-  best.visible_fraction = -1.0;
-  for (Eigen::Index k = 0; k < dirs.cols(); ++k) {
-    const ScoredView s =
-        score(u, centroid, centroid + r_sphere * dirs.col(k), sampling.occluder_radius);
-    if (s.visible_fraction > best.visible_fraction ||
-        (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
-      best = s;
-    }
-  }
-  return best;
+  return sample_best(usable_input(problem, centroid, r_sphere), centroid, r_sphere, sampling);
+}
+
+ScoredView sample_best_view(const OcclusionField& field, const SamplingSettings& sampling) {
+  return sample_best(field.usable(), field.centroid(), field.r_sphere(), sampling);
 }
 
 ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere,
                              const Eigen::Vector3d& current, const std::vector<Eigen::Vector3d>& others,
                              const MostVisibleSettings& settings) {
-  const UsableInput u = usable_input(problem, centroid, r_sphere);
-  const auto on_sphere = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-    const Eigen::Vector3d d = p - centroid;
-    return d.norm() > 1e-12 ? Eigen::Vector3d(centroid + r_sphere * d.normalized()) : centroid + r_sphere * Eigen::Vector3d::UnitZ();
-  };
-  const Eigen::Vector3d here = on_sphere(current);
-  const ScoredView held = score(u, centroid, here, settings.occluder_radius);
-  ScoredView best = held;
-  const auto consider = [&](const Eigen::Vector3d& view) {
-    const ScoredView s = score(u, centroid, on_sphere(view), settings.occluder_radius);
-    if (s.visible_fraction > best.visible_fraction ||
-        (s.visible_fraction == best.visible_fraction && s.mean_error_deg < best.mean_error_deg)) {
-      best = s;
-    }
-  };
-  // Eight neighbours: rotate `here` about two tangent axes by step_deg.
-  const Eigen::Vector3d w = (here - centroid).normalized();
-  const Eigen::Vector3d a = w.unitOrthogonal();
-  const Eigen::Vector3d b = w.cross(a);
-  const double step = settings.step_deg * kPi / 180.0;
-  for (int k = 0; k < 8; ++k) {
-    const double phi = kPi / 4.0 * k;
-    const Eigen::Vector3d tangent = std::cos(phi) * a + std::sin(phi) * b;
-    consider(centroid + r_sphere * (std::cos(step) * w + std::sin(step) * tangent));
-  }
-  for (const Eigen::Vector3d& o : others) consider(o);
-  return best.visible_fraction >= held.visible_fraction + settings.margin ? best : held;
+  return most_visible(usable_input(problem, centroid, r_sphere), centroid, r_sphere, current, others, settings);
+}
+
+ScoredView most_visible_view(const OcclusionField& field, const Eigen::Vector3d& current,
+                             const std::vector<Eigen::Vector3d>& others, const MostVisibleSettings& settings) {
+  return most_visible(field.usable(), field.centroid(), field.r_sphere(), current, others, settings);
 }
 
 }  // namespace ofv

@@ -2,12 +2,14 @@
 // implementation of ESTIMATOR-SPEC.md), judged as spec §9 and their README say.
 #include "ofv/estimator.h"
 #include "ofv/io/scene_json.h"
+#include "ofv/view_methods.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 namespace ofv {
 namespace {
@@ -96,6 +98,46 @@ TEST_P(Conformance, MatchesTheIndependentImplementation) {
                 projected_within(scene.problem, e, settings, e.tf) == 0);
     }
   }
+}
+
+// One field serves every start and every view score on the frame: the
+// same results, bit for bit, as the problem given whole each time.
+TEST_P(Conformance, OneOcclusionFieldServesEveryEstimateAndScore) {
+  const Scene scene = read_scene((fs::path(OFV_TEST_DATA_DIR) / "conformance" / (GetParam() + ".json")).string());
+  EstimatorSettings settings = scene.params.resolve();
+  ViewProblem problem = scene.problem;
+  const OcclusionField field(problem, settings.r_sphere);
+  const ViewEstimate whole = estimate_view(problem, settings);
+  const ViewEstimate prepared = estimate_view(field, settings, problem.previous_view);
+  EXPECT_EQ(prepared.status, whole.status);
+  EXPECT_EQ(prepared.t0, whole.t0);
+  EXPECT_EQ(prepared.tf, whole.tf);
+  EXPECT_EQ(prepared.iterations, whole.iterations);
+  EXPECT_EQ(prepared.skipped_supervoxels, whole.skipped_supervoxels);
+  EXPECT_EQ(prepared.skipped_occluders, whole.skipped_occluders);
+  EXPECT_EQ(prepared.occlusion_points, whole.occlusion_points);
+  EXPECT_EQ(field.occlusion_points(), whole.occlusion_points);
+  if (whole.status == ViewStatus::NoSupervoxels) {
+    EXPECT_FALSE(field.has_object());
+    return;
+  }
+  EXPECT_EQ(field.centroid(), whole.centroid);
+  // A warm start from elsewhere on the same field.
+  settings.warm_start = true;
+  problem.previous_view = whole.centroid + settings.r_sphere * Eigen::Vector3d(1, -2, 0.5).normalized();
+  const ViewEstimate warm_whole = estimate_view(problem, settings);
+  const ViewEstimate warm = estimate_view(field, settings, problem.previous_view);
+  EXPECT_EQ(warm.tf, warm_whole.tf);
+  EXPECT_EQ(warm.iterations, warm_whole.iterations);
+  for (const Eigen::Vector3d& view : {whole.t0, whole.tf, *problem.previous_view}) {
+    const ScoredView a = score_view(field, view, 0.02);
+    const ScoredView b = score_view(problem, whole.centroid, settings.r_sphere, view, 0.02);
+    EXPECT_EQ(a.visible_fraction, b.visible_fraction);
+    EXPECT_EQ(a.mean_error_deg, b.mean_error_deg);
+  }
+  // The field is R's: another radius is refused.
+  settings.r_sphere *= 2.0;
+  EXPECT_THROW((void)estimate_view(field, settings, std::nullopt), std::invalid_argument);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, Conformance, testing::ValuesIn(case_names()),

@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -181,6 +182,86 @@ struct EstimateOptions {
   bool record_path = false;  ///< fill ViewEstimate::path
 };
 
+/// \brief What the estimator uses of a problem for a given C and R: the
+///        supervoxels of spec §7 inside the sphere (§1) and the usable occluders.
+struct UsableInput {
+  Eigen::Matrix3Xd positions;  ///< 3 x N v_n [m]
+  Eigen::Matrix3Xd normals;    ///< 3 x N unit normals p_n
+  Eigen::Matrix3Xd rays;       ///< 3 x N s_n - C: where the normal leaves the sphere, from C [m]
+  Eigen::Matrix3Xd occluders;  ///< 3 x B finite q_b [m]
+};
+
+/// \brief The supervoxels, rays and occluders the estimator would use with
+///        centroid `centroid` and radius `r_sphere` (for baselines and metrics).
+[[nodiscard]] UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere);
+
+/**
+ * \brief One frame's problem prepared once for every estimate and view score
+ *        made on it: the usable supervoxels and occluders (spec §7), C and
+ *        the axes, the normals-to-sphere rays (§1) and the occlusion-to-sphere
+ *        rays (§3), the part of the estimator that grows with supervoxels x
+ *        occluders.
+ *
+ * A loop that estimates the same frame from several starts (the warm start
+ * from its previous target, anticipated occluders) and scores views on it
+ * (score_view(), most_visible_view()) builds one field per set of occluders
+ * and hands it to each call. The field does not hold the problem's
+ * previous_view: each estimate_view() call on it gives its own. Movable, not
+ * copyable; immutable once built, so calls on one field may run on several
+ * threads.
+ */
+namespace detail {
+struct FieldAccess;
+}
+
+class OcclusionField {
+ public:
+  /**
+   * \param problem  the frame (world frame); its previous_view is only checked.
+   * \param r_sphere R [m], finite and > 0; estimates on the field must use it.
+   * \throws std::invalid_argument as estimate_view() does for the problem, or
+   *         when the occlusion rays would be more than ofv handles (10^8).
+   */
+  OcclusionField(const ViewProblem& problem, double r_sphere);
+  ~OcclusionField();
+  OcclusionField(OcclusionField&&) noexcept;
+  OcclusionField& operator=(OcclusionField&&) noexcept;
+  OcclusionField(const OcclusionField&) = delete;
+  OcclusionField& operator=(const OcclusionField&) = delete;
+
+  /// R [m].
+  [[nodiscard]] double r_sphere() const;
+  /// Whether there is an object: a usable supervoxel or a given C. Without
+  /// one, estimate_view() returns ViewStatus::NoSupervoxels.
+  [[nodiscard]] bool has_object() const;
+  /// C [m] (zero without an object).
+  [[nodiscard]] const Eigen::Vector3d& centroid() const;
+  /// The supervoxels inside the sphere with their rays, and the usable occluders.
+  [[nodiscard]] const UsableInput& usable() const;
+  /// N_C: the occlusion-to-sphere points.
+  [[nodiscard]] int occlusion_points() const;
+
+ private:
+  friend struct detail::FieldAccess;
+  struct Data;
+  std::unique_ptr<Data> data_;
+};
+
+/**
+ * \brief estimate_view() on a prepared field, warm-started (with
+ *        EstimatorSettings::warm_start) from `previous_view`. Equal to
+ *        estimate_view(problem, settings, options) with the field's problem
+ *        and that previous_view; only the field's preparation is not counted in
+ *        the time budget.
+ * \throws std::invalid_argument on invalid settings, a settings.r_sphere other
+ *         than the field's, a non-finite or far previous_view, and the errors
+ *         of estimate_view() that depend on the start (t0's camera fallback,
+ *         a warm start from C).
+ */
+[[nodiscard]] ViewEstimate estimate_view(const OcclusionField& field, const EstimatorSettings& settings,
+                                         const std::optional<Eigen::Vector3d>& previous_view,
+                                         const EstimateOptions& options = {});
+
 /**
  * \brief Estimates the occlusion-free view for one frame (spec §1-§6).
  *
@@ -215,19 +296,6 @@ struct EstimateOptions {
  *        most 3·10^6 points are prepared. Results do not depend on it.
  */
 void reserve_estimator_memory(std::size_t occlusion_points);
-
-/// \brief What the estimator uses of a problem for a given C and R: the
-///        supervoxels of spec §7 inside the sphere (§1) and the usable occluders.
-struct UsableInput {
-  Eigen::Matrix3Xd positions;  ///< 3 x N v_n [m]
-  Eigen::Matrix3Xd normals;    ///< 3 x N unit normals p_n
-  Eigen::Matrix3Xd rays;       ///< 3 x N s_n - C: where the normal leaves the sphere, from C [m]
-  Eigen::Matrix3Xd occluders;  ///< 3 x B finite q_b [m]
-};
-
-/// \brief The supervoxels, rays and occluders the estimator would use with
-///        centroid `centroid` and radius `r_sphere` (for baselines and metrics).
-[[nodiscard]] UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere);
 
 /**
  * \brief Angle between two directions [rad], robust near 0 and pi.

@@ -65,6 +65,9 @@ struct ScoredView {
 [[nodiscard]] ScoredView score_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                                     double r_sphere, const Eigen::Vector3d& view,
                                     double occluder_radius);
+/// \brief score_view() on a prepared field: its supervoxels, occluders and C.
+[[nodiscard]] ScoredView score_view(const OcclusionField& field, const Eigen::Vector3d& view,
+                                    double occluder_radius);
 
 /**
  * \brief Mean angular error (eq. 9, spec §6) of a camera position: the angle,
@@ -81,6 +84,8 @@ struct ScoredView {
 [[nodiscard]] ScoredView sample_best_view(const ViewProblem& problem,
                                           const Eigen::Vector3d& centroid, double r_sphere,
                                           const SamplingSettings& sampling);
+/// \brief sample_best_view() on a prepared field: its supervoxels, occluders, C and R.
+[[nodiscard]] ScoredView sample_best_view(const OcclusionField& field, const SamplingSettings& sampling);
 
 /// \brief Settings of most_visible_view().
 struct MostVisibleSettings {
@@ -106,6 +111,10 @@ struct MostVisibleSettings {
  */
 [[nodiscard]] ScoredView most_visible_view(const ViewProblem& problem, const Eigen::Vector3d& centroid,
                                            double r_sphere, const Eigen::Vector3d& current,
+                                           const std::vector<Eigen::Vector3d>& others,
+                                           const MostVisibleSettings& settings);
+/// \brief most_visible_view() on a prepared field: its supervoxels, occluders, C and R.
+[[nodiscard]] ScoredView most_visible_view(const OcclusionField& field, const Eigen::Vector3d& current,
                                            const std::vector<Eigen::Vector3d>& others,
                                            const MostVisibleSettings& settings);
 

@@ -345,7 +345,8 @@ struct ViewLoop::Impl {
   // What one frame brings to the stages after the world model.
   struct Frame {
     const ViewProblem& problem;  // seen and presumed occluders
-    Eigen::Index seen;           // its first `seen` occluders were seen
+    const OcclusionField& field;  // prepared from `problem`
+    Eigen::Index seen;            // its first `seen` occluders were seen
     const ViewEstimate& estimate;
     Eigen::Vector3d here;
     double shown;  // [m²]
@@ -356,9 +357,10 @@ struct ViewLoop::Impl {
   void reset();
 
   // --- proposers
-  ViewEstimate estimate_view_counted(const ViewProblem& problem, const EstimatorSettings& settings);
-  std::optional<ViewEstimate> from_previous_target(const ViewProblem& problem);
-  Candidate pursue(const ViewProblem& problem, LoopStep& out);
+  ViewEstimate estimate_view_counted(const OcclusionField& field, const EstimatorSettings& settings,
+                                     const std::optional<Eigen::Vector3d>& start);
+  std::optional<ViewEstimate> from_previous_target(const OcclusionField& field);
+  Candidate pursue(const ViewProblem& problem, const OcclusionField& field, LoopStep& out);
   Candidate look_ahead(const Frame& f, const Candidate& pursuit) const;
   // --- the mode machine
   void transition(Guard guard, LoopStep& out);
@@ -407,58 +409,57 @@ void ViewLoop::Impl::reset() {
   last_centroid.reset();
 }
 
-ViewEstimate ViewLoop::Impl::estimate_view_counted(const ViewProblem& problem, const EstimatorSettings& s) {
+ViewEstimate ViewLoop::Impl::estimate_view_counted(const OcclusionField& field, const EstimatorSettings& s,
+                                                   const std::optional<Eigen::Vector3d>& start) {
   ++estimator_calls;
-  return estimate_view(problem, s);
+  return estimate_view(field, s, start);
 }
 
-std::optional<ViewEstimate> ViewLoop::Impl::from_previous_target(const ViewProblem& problem) {
+std::optional<ViewEstimate> ViewLoop::Impl::from_previous_target(const OcclusionField& field) {
   if (!settings.target_hysteresis || !previous_target) return std::nullopt;
-  ViewProblem from_previous = problem;
-  from_previous.previous_view = *previous_target;
   EstimatorSettings warm = estimator;
   warm.warm_start = true;
-  return estimate_view_counted(from_previous, warm);
+  return estimate_view_counted(field, warm, previous_target);
 }
 
 // The proposers of mode pursue: the frame's estimate, the anticipated
 // estimate, the warm start from the previous target, or a baseline's view.
-Candidate ViewLoop::Impl::pursue(const ViewProblem& problem, LoopStep& out) {
+Candidate ViewLoop::Impl::pursue(const ViewProblem& problem, const OcclusionField& field, LoopStep& out) {
   const ViewEstimate& estimate = *out.estimate;
-  const ViewProblem* basis = &problem;
-  ViewProblem ahead;
+  const OcclusionField* basis = &field;
+  std::optional<OcclusionField> ahead;
   std::optional<ViewEstimate> kept;  // from the previous target, on `ahead`
   if (settings.anticipation.mode == Anticipation::Predict) {
     const AnticipationSettings& a = settings.anticipation;
     const Eigen::Matrix3Xd future = world.predicted(a.horizon, a.samples, estimate.centroid, estimator.r_sphere);
     if (future.cols() > 0) {
-      ahead = problem;
-      ahead.occluders.resize(3, problem.occluders.cols() + future.cols());
-      ahead.occluders << problem.occluders, future;
+      ViewProblem with_future = problem;
+      with_future.occluders.resize(3, problem.occluders.cols() + future.cols());
+      with_future.occluders << problem.occluders, future;
+      ahead.emplace(with_future, estimator.r_sphere);
       // From the view clear of the occluders as they are now (the spec's
       // warm start): fewer iterations than from t0 when the future ones
       // only nudge it. That view stays the target if it is clear of the
       // predicted occluders too (0 iterations: only whether the start is
       // clear). Otherwise the warm start from the previous target, if it
       // is free; only then the search from the frame's view.
-      ahead.previous_view = estimate.tf;
       EstimatorSettings from_now = estimator;
       from_now.warm_start = true;
       from_now.max_iterations = 0;
-      ViewEstimate anticipated = estimate_view_counted(ahead, from_now);
+      ViewEstimate anticipated = estimate_view_counted(*ahead, from_now, estimate.tf);
       if (!is_free(anticipated.status)) {
-        kept = settings.method == ViewMethod::Estimator ? from_previous_target(ahead) : std::nullopt;
+        kept = settings.method == ViewMethod::Estimator ? from_previous_target(*ahead) : std::nullopt;
         if (kept && is_free(kept->status)) {
           anticipated = *kept;
         } else {
           from_now.max_iterations = estimator.max_iterations;
-          anticipated = estimate_view_counted(ahead, from_now);
+          anticipated = estimate_view_counted(*ahead, from_now, estimate.tf);
         }
       }
       if (is_free(anticipated.status)) {
         out.predicted_occluders = future.cols();
         out.anticipated = std::move(anticipated);
-        basis = &ahead;
+        basis = &*ahead;
       } else {
         kept.reset();  // on `ahead`, not on the basis
       }
@@ -470,13 +471,13 @@ Candidate ViewLoop::Impl::pursue(const ViewProblem& problem, LoopStep& out) {
     case ViewMethod::Static: return {};
     case ViewMethod::InitialView: return {chosen.t0, Proposer::InitialView};
     case ViewMethod::Sampling: {
-      const Eigen::Vector3d best = sample_best_view(*basis, chosen.centroid, r_sphere, settings.sampling).view;
+      const Eigen::Vector3d best = sample_best_view(*basis, settings.sampling).view;
       if (!settings.target_hysteresis || !previous_target) return {best, Proposer::Sampling};
       // Keep the previous view while it sees as much as the new best.
       const Eigen::Vector3d previous = chosen.centroid + r_sphere * (*previous_target - chosen.centroid).normalized();
       const double rho = settings.sampling.occluder_radius;
-      const bool keep = score_view(*basis, chosen.centroid, r_sphere, previous, rho).visible_fraction >=
-                        score_view(*basis, chosen.centroid, r_sphere, best, rho).visible_fraction;
+      const bool keep =
+          score_view(*basis, previous, rho).visible_fraction >= score_view(*basis, best, rho).visible_fraction;
       return {keep ? previous : best, Proposer::Sampling};
     }
     case ViewMethod::Estimator: break;
@@ -507,7 +508,7 @@ Candidate ViewLoop::Impl::look_ahead(const Frame& f, const Candidate& pursuit) c
   const double r = estimator.r_sphere;
   const Eigen::Vector3d from = (f.here - c).normalized();
   const auto score = [&](const Eigen::Vector3d& direction) {
-    return score_view(f.problem, c, r, c + r * direction, s.climb.occluder_radius).visible_fraction;
+    return score_view(f.field, c + r * direction, s.climb.occluder_radius).visible_fraction;
   };
   const double now = score(from);
   // How far the camera may go before a frame shows the loss and it stops:
@@ -532,7 +533,7 @@ Candidate ViewLoop::Impl::look_ahead(const Frame& f, const Candidate& pursuit) c
   // Climb to a nearby view that sees clearly more, if the way there keeps
   // what the camera sees (holding alone, it would stay wherever it
   // started); else hold.
-  const Eigen::Vector3d climb = most_visible_view(f.problem, c, r, f.here, {}, s.climb).view;
+  const Eigen::Vector3d climb = most_visible_view(f.field, f.here, {}, s.climb).view;
   if (loses_on_the_way(climb)) return {Eigen::Vector3d(c + r * from), Proposer::Here};
   return {climb, Proposer::Climb};
 }
@@ -573,15 +574,18 @@ bool ViewLoop::Impl::camera_cost_view(const Frame& f) {
   if (low_frames < s.frames) return false;
   const Eigen::Vector3d& c = f.estimate.centroid;
   const double r = estimator.r_sphere;
-  const auto score = [&](const ViewProblem& scene, const Eigen::Vector3d& p) {
-    return score_view(scene, c, r, c + r * (p - c).normalized(), s.climb.occluder_radius).visible_fraction;
-  };
+  const double rho = s.climb.occluder_radius;
+  const auto on_sphere = [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(c + r * (p - c).normalized()); };
   const Eigen::Matrix3Xd still = world.revealed_still(best_seen->tracks);
   ViewProblem then = f.problem;
   then.occluders.resize(3, best_seen->occluders.cols() + still.cols());
   then.occluders << best_seen->occluders, still;
-  if (!(score(then, f.here) < keep * score(then, best_seen->position))) return false;
-  return score(f.problem, best_seen->position) >= score(f.problem, f.here);
+  const auto score_then = [&](const Eigen::Vector3d& p) {
+    return score_view(then, c, r, on_sphere(p), rho).visible_fraction;
+  };
+  if (!(score_then(f.here) < keep * score_then(best_seen->position))) return false;
+  return score_view(f.field, on_sphere(best_seen->position), rho).visible_fraction >=
+         score_view(f.field, on_sphere(f.here), rho).visible_fraction;
 }
 
 // The mode machine in a frame that found the object (the retreat on).
@@ -645,12 +649,13 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
   const Eigen::Vector3d here = observation.wMc.translation();
   // The estimator avoids the occluders seen and those presumed (last).
   std::optional<ViewProblem> problem = observation.problem;
+  std::optional<OcclusionField> field;  // the occlusion field, once per frame
   const Eigen::Index seen = problem ? problem->occluders.cols() : 0;
   if (problem) {
     if (observation.presumed.cols() > 0) problem->occluders = observation.all_occluders();
     problem->camera = here;
-    problem->previous_view = previous_view;
-    out.estimate = estimate_view_counted(*problem, estimator);
+    field.emplace(*problem, estimator.r_sphere);
+    out.estimate = estimate_view_counted(*field, estimator, previous_view);
     if (out.estimate->status == ViewStatus::NoSupervoxels) out.estimate.reset();
     out.presumed_occluders = problem->occluders.cols() - seen;
   }
@@ -667,10 +672,10 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
       case ViewStatus::OutOfTime: out.status = StepStatus::NotConverged; break;
       default: out.status = StepStatus::NoOccluders; break;
     }
-    const Candidate pursuit = pursue(*problem, out);
+    const Candidate pursuit = pursue(*problem, *field, out);
     selected = pursuit;
     if (retreat && observation.shown_area) {
-      const Frame f{*problem, seen, *out.estimate, here, *observation.shown_area, dt, observation.age};
+      const Frame f{*problem, *field, seen, *out.estimate, here, *observation.shown_area, dt, observation.age};
       found(f, out);
       if (mode == LoopMode::Pursue) selected = look_ahead(f, pursuit);
       if (mode == LoopMode::Hold) selected = {held->position, Proposer::BestSeen};
