@@ -25,13 +25,13 @@ ofv::RgbdFrame scene_frame(int width, std::vector<int>* labels = nullptr) {
 void BM_Perception(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
   const ofv::RgbdFrame frame = scene_frame(width);
-  ofv::Perception perception{ofv::PerceptionSettings{}};
+  ofv::perception::Perception perception{ofv::perception::PerceptionSettings{}};
   (void)perception.process(frame);  // frame 0: selection
-  ofv::PerceptionTimings sum;
-  ofv::PerceptionCounts counts;
+  ofv::perception::PerceptionTimings sum;
+  ofv::perception::PerceptionCounts counts;
   for (auto _ : state) {
-    const ofv::PerceptionResult r = perception.process(frame);
-    if (r.status == ofv::TrackingStatus::Lost) {
+    const ofv::perception::PerceptionResult r = perception.process(frame);
+    if (r.status == ofv::perception::TrackingStatus::Lost) {
       state.SkipWithError("object lost");
       break;
     }
@@ -60,15 +60,15 @@ void BM_PerceptionScores(benchmark::State& state) {
   std::vector<int> labels;
   ofv::RgbdFrame frame = scene_frame(static_cast<int>(state.range(0)), &labels);
   frame.labels.assign(labels.begin(), labels.end());  // the synthetic scene's own label values
-  const ofv::PerceptionSettings settings;
-  ofv::Perception perception{settings};
+  const ofv::perception::PerceptionSettings settings;
+  ofv::perception::Perception perception{settings};
   (void)perception.process(frame);
-  const ofv::PerceptionResult r = perception.process(frame);
-  ofv::PerceptionTruth truth;
+  const ofv::perception::PerceptionResult r = perception.process(frame);
+  ofv::perception::PerceptionTruth truth;
   truth.centroid = r.centroid;
   truth.r_sphere = settings.r_sphere;
   for (auto _ : state) {
-    const ofv::PerceptionScores s = ofv::score_perception(frame, r, truth, settings);
+    const ofv::perception::PerceptionScores s = ofv::perception::score_perception(frame, r, truth, settings);
     benchmark::DoNotOptimize(s.object_cells);
   }
 }

@@ -18,9 +18,9 @@ vpHomogeneousMatrix start_pose() {
 
 // Arg 0: PBVS, 1: the sphere feature.
 void BM_ControllerUpdate(benchmark::State& state) {
-  ofv::ControllerSettings settings;
-  settings.law = state.range(0) == 0 ? ofv::ControllerSettings::Law::Pbvs : ofv::ControllerSettings::Law::Sphere;
-  ofv::ViewController controller(settings);
+  ofv::servo::ControllerSettings settings;
+  settings.law = state.range(0) == 0 ? ofv::servo::ControllerSettings::Law::Pbvs : ofv::servo::ControllerSettings::Law::Sphere;
+  ofv::servo::ViewController controller(settings);
   const vpHomogeneousMatrix wMc = start_pose();
   const Eigen::Vector3d target(0.5 * std::sin(0.7), 0.0, -0.5 * std::cos(0.7));
   for (auto _ : state) {
@@ -32,15 +32,15 @@ BENCHMARK(BM_ControllerUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 // Arg: 0 camera, 1 viper850, 2 afma6.
 void BM_RobotStep(benchmark::State& state) {
-  static const std::array<ofv::RobotKind, 3> kinds{ofv::RobotKind::Camera, ofv::RobotKind::Viper850, ofv::RobotKind::Afma6};
-  const auto robot = ofv::make_robot(kinds[static_cast<std::size_t>(state.range(0))], start_pose());
+  static const std::array<ofv::servo::RobotKind, 3> kinds{ofv::servo::RobotKind::Camera, ofv::servo::RobotKind::Viper850, ofv::servo::RobotKind::Afma6};
+  const auto robot = ofv::servo::make_robot(kinds[static_cast<std::size_t>(state.range(0))], start_pose());
   state.SetLabel(robot->name());
   vpColVector v(6, 0.0);
   v[0] = 0.01;
   v[4] = 0.02;
   double sign = 1.0;
   for (auto _ : state) {
-    const ofv::RobotStep r = robot->step(sign * v, 1.0 / 30.0);  // back and forth, away from the limits
+    const ofv::servo::RobotStep r = robot->step(sign * v, 1.0 / 30.0);  // back and forth, away from the limits
     benchmark::DoNotOptimize(r.wMc.data);
     sign = -sign;
   }

@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
 
   // The feature and its desired value (zero: on the sphere, on the target's
   // ray, object centred).
-  ofv::FeatureSphereView s, s_star;
+  ofv::servo::FeatureSphereView s, s_star;
   vpServo task;
   task.setServo(vpServo::EYEINHAND_CAMERA);
   task.setInteractionMatrixType(vpServo::CURRENT);
@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
     if (live) {
       ofv::DisplayInput in;
       in.time = 0.04 * k;
-      in.wMc = ofv::to_eigen(wMc);
+      in.wMc = ofv::servo::to_eigen(wMc);
       in.centroid = Eigen::Vector3d(centroid[0], centroid[1], centroid[2]);
       in.target = Eigen::Vector3d(tf[0], tf[1], tf[2]);
       in.velocity = v;

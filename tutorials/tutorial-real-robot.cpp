@@ -1,8 +1,8 @@
 //! \example tutorial-real-robot.cpp
 //! Tutorial 4: attach a real robot. Any ViSP vpRobot driver carries the camera;
-//! ofv::VispRobot commands it in the camera frame. ofv::ViewLoop is the
+//! ofv::servo::VispRobot commands it in the camera frame. ofv::servo::ViewLoop is the
 //! per-frame policy that `ofv simulate` and `ofv run` use: from the frame's
-//! observation (object supervoxels and occluders, from ofv::PerceptionObserver
+//! observation (object supervoxels and occluders, from ofv::perception::PerceptionObserver
 //! on your sensor's frames, and the camera pose) to a safe camera twist — view
 //! selection, target continuity, the controller and the safety filter
 //! (speed, acceleration, workspace, zero velocity when the object is lost or
@@ -17,9 +17,9 @@
 //! view and the curves. A left click pauses (the robot is sent a zero
 //! velocity first), a right click or q stops as Ctrl-C does.
 //!
-//! With a sensor, `ofv::run_on_robot(source, perception, robot, settings,
+//! With a sensor, `ofv::servo::run_on_robot(source, perception, robot, settings,
 //! options)` runs this same loop until Ctrl-C, `perception` an
-//! ofv::PerceptionObserver; `ofv run` is that call. The front end's
+//! ofv::perception::PerceptionObserver; `ofv run` is that call. The front end's
 //! `PerceptionSettings::selection` points out the object in the first frame
 //! (a world box or an image rectangle, as `ofv run --box` / `--rect`); by
 //! default it takes the cluster nearest the image centre.
@@ -44,7 +44,7 @@ namespace {
 volatile std::sig_atomic_t stop_requested = 0;
 void on_sigint(int) { stop_requested = 1; }
 
-// Stand-in for ofv::Perception's output: a 10 x 10 cm patch 0.8 m ahead
+// Stand-in for ofv::perception::Perception's output: a 10 x 10 cm patch 0.8 m ahead
 // facing the camera, and a hand-sized occluder that crosses its line of sight.
 ofv::ViewProblem frame_problem(double t) {
   ofv::ViewProblem p;
@@ -69,22 +69,22 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_sigint);  // Ctrl-C: zero velocity, then exit
 
   // 1. Settings by name, as `ofv run --set` takes them; here a workspace box for the camera.
-  ofv::LoopSettings settings;
-  ofv::loop_settings_table().set(settings, "workspace", "-0.4,-0.4,0.1,0.4,0.4,0.9");
-  ofv::loop_settings_table().set(settings, "max_linear_speed", "0.25");
-  ofv::ViewLoop loop(settings);
+  ofv::servo::LoopSettings settings;
+  ofv::servo::loop_settings_table().set(settings, "workspace", "-0.4,-0.4,0.1,0.4,0.4,0.9");
+  ofv::servo::loop_settings_table().set(settings, "max_linear_speed", "0.25");
+  ofv::servo::ViewLoop loop(settings);
 
   // 2. The robot.
 #if defined(VISP_HAVE_VIPER850)
   vpRobotViper850 driver;
-  ofv::VispRobot robot(driver, vpHomogeneousMatrix(), "viper850");
+  ofv::servo::VispRobot robot(driver, vpHomogeneousMatrix(), "viper850");
 #else
   if (!dry_run) {
     std::cout << "This ViSP has no real-robot driver (VISP_HAVE_VIPER850, VISP_HAVE_FRANKA, ...); "
                  "run with --dry-run to see the commands on a simulated camera.\n";
     return 0;
   }
-  ofv::FreeFlyingCamera robot(vpHomogeneousMatrix(0.0, 0.0, 0.3, 0.0, 0.0, 0.0));
+  ofv::servo::FreeFlyingCamera robot(vpHomogeneousMatrix(0.0, 0.0, 0.3, 0.0, 0.0, 0.0));
 #endif
 
   // 3. The loop: one frame period at a time.
@@ -113,24 +113,24 @@ int main(int argc, char** argv) {
 #endif
   int clear = 0;
   for (int k = 0; k < 60 && !stop_requested; ++k) {
-    ofv::Observation seen;  // what ofv::PerceptionObserver::observe gives for a frame
+    ofv::Observation seen;  // what ofv::perception::PerceptionObserver::observe gives for a frame
     seen.problem = frame_problem(k * dt);
     const vpHomogeneousMatrix wMc = robot.wMc();
-    seen.wMc = ofv::to_eigen(wMc);
+    seen.wMc = ofv::servo::to_eigen(wMc);
     seen.age = 0.0;  // how old the frame is when the command is sent
-    const ofv::LoopStep s = loop.step(seen, dt);
+    const ofv::servo::LoopStep s = loop.step(seen, dt);
     if (dry_run) {
       std::cout << "step " << k << ": " << ofv::to_string(s.status) << ", v = " << s.velocity.t();
-      if (s.safety != ofv::SafetyAction::None) std::cout << "  (" << ofv::to_string(s.safety) << ')';
+      if (s.safety != ofv::servo::SafetyAction::None) std::cout << "  (" << ofv::to_string(s.safety) << ')';
       std::cout << '\n';
     }
-    clear += s.status == ofv::StepStatus::Converged || s.status == ofv::StepStatus::NoOccluders ? 1 : 0;
+    clear += s.status == ofv::servo::StepStatus::Converged || s.status == ofv::servo::StepStatus::NoOccluders ? 1 : 0;
     robot.step(s.velocity, dt);
 #if defined(OFV_HAVE_DISPLAY)
     if (live) {
       ofv::DisplayInput in;
       in.time = k * dt;
-      in.wMc = ofv::to_eigen(wMc);
+      in.wMc = ofv::servo::to_eigen(wMc);
       in.observation = &seen;
       in.step = &s;
       if (!live->show(in)) stop_requested = 1;  // the same stop as Ctrl-C

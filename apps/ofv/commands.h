@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 struct ObjectSelection;
-}  // namespace ofv
+}  // namespace ofv::perception
 
 namespace ofv::cli {
 
@@ -70,7 +70,7 @@ void add_selection_options(CLI::App& app, std::string& box, std::string& rect);
 /// The selection those options ask for; the front end's default without them.
 /// \throws std::invalid_argument naming the option when it is not six (box)
 ///         or four (rect) comma-separated numbers.
-ObjectSelection object_selection(const std::string& box, const std::string& rect);
+perception::ObjectSelection object_selection(const std::string& box, const std::string& rect);
 
 /// Registers `ofv record` (a simulated episode exported as .oni/TUM/PCD) on the app.
 Command add_record_command(CLI::App& app);

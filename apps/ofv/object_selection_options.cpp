@@ -47,11 +47,11 @@ void add_selection_options(CLI::App& app, std::string& box, std::string& rect) {
       ->excludes(by_box);
 }
 
-ObjectSelection object_selection(const std::string& box, const std::string& rect) {
-  ObjectSelection selection;
+perception::ObjectSelection object_selection(const std::string& box, const std::string& rect) {
+  perception::ObjectSelection selection;
   if (!box.empty()) {
     const auto b = parse_numbers(box, 6, "--box");
-    selection.mode = ObjectSelection::Mode::Box;
+    selection.mode = perception::ObjectSelection::Mode::Box;
     selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5]));
     if (selection.box.isEmpty()) {
       throw std::invalid_argument("--box " + box + ": empty (needs X0 <= X1, Y0 <= Y1, Z0 <= Z1)");
@@ -63,7 +63,7 @@ ObjectSelection object_selection(const std::string& box, const std::string& rect
         throw std::invalid_argument("--rect " + rect + ": pixels are whole numbers");
       }
     }
-    selection.mode = ObjectSelection::Mode::Image;
+    selection.mode = perception::ObjectSelection::Mode::Image;
     selection.rect = Eigen::AlignedBox2i(Eigen::Vector2i(static_cast<int>(b[0]), static_cast<int>(b[1])),
                                          Eigen::Vector2i(static_cast<int>(b[2]), static_cast<int>(b[3])));
     if (selection.rect.isEmpty()) {

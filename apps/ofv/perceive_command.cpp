@@ -1,6 +1,6 @@
 // `ofv perceive SOURCE [--out DIR] [--pictures]`: the perception front end
 // and the estimator on every frame of a recording or device. The loop is
-// ofv::perceive() and the records ofv/perception/perceive_files.h: this file
+// ofv::perception::perceive() and the records ofv/perception/perceive_files.h: this file
 // parses the options, calls them and prints.
 #include "commands.h"
 
@@ -48,16 +48,16 @@ struct Options {
   std::string rect;
   int max_frames = -1;
   float speed = OpenNi2Options{}.playback_speed;
-  double voxel = SupervoxelSettings{}.voxel_resolution;
-  double obb_margin = PerceptionSettings{}.obb_margin;
-  double max_motion = TrackingSettings{}.max_motion;
+  double voxel = perception::SupervoxelSettings{}.voxel_resolution;
+  double obb_margin = perception::PerceptionSettings{}.obb_margin;
+  double max_motion = perception::TrackingSettings{}.max_motion;
   bool no_plane_occluders = false;
 };
 
 /// The front end's settings: the options, and the estimator's R_seed and R_sphere.
 /// \throws std::invalid_argument naming the option or setting that is invalid.
-PerceptionSettings perception_settings(const Options& opt, const EstimatorSettings& settings) {
-  PerceptionSettings ps = ofv::perception_settings(settings);
+perception::PerceptionSettings perception_settings(const Options& opt, const EstimatorSettings& settings) {
+  perception::PerceptionSettings ps = ofv::perception::perception_settings(settings);
   ps.supervoxels.voxel_resolution = opt.voxel;
   ps.obb_margin = opt.obb_margin;
   ps.tracking.max_motion = opt.max_motion;
@@ -99,7 +99,7 @@ Command add_perceive_command(CLI::App& app) {
             std::unique_ptr<FrameSource> source;
             EstimatorParams params;
             EstimatorSettings settings;
-            PerceptionSettings ps;
+            perception::PerceptionSettings ps;
             try {
               if (opt->pictures && opt->out.empty()) {
                 throw std::invalid_argument("--pictures needs --out DIR");
@@ -126,8 +126,8 @@ Command add_perceive_command(CLI::App& app) {
             }
 
             try {
-              const PerceiveSummary summary = perceive(
-                  *source, ps, settings, opt->max_frames, [&](const PerceivedFrame& f) {
+              const perception::PerceiveSummary summary = perceive(
+                  *source, ps, settings, opt->max_frames, [&](const perception::PerceivedFrame& f) {
                     if (opt->out.empty()) {
                       std::cout << perceived_frame_json(f, params) << '\n';
                     } else {

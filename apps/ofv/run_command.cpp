@@ -63,20 +63,20 @@ std::string real_drivers() {
 }
 
 // A real driver by name, or nullptr for the simulated robots.
-std::unique_ptr<CameraRobot> real_robot(const std::string& name, const vpHomogeneousMatrix& eMc) {
+std::unique_ptr<servo::CameraRobot> real_robot(const std::string& name, const vpHomogeneousMatrix& eMc) {
   (void)eMc;
 #if defined(VISP_HAVE_VIPER850)
   if (name == "viper850-real") {
     static vpRobotViper850 driver;
     driver.init(vpViper850::TOOL_CUSTOM, eMc);
-    return std::make_unique<VispRobot>(driver, vpHomogeneousMatrix(), name);
+    return std::make_unique<servo::VispRobot>(driver, vpHomogeneousMatrix(), name);
   }
 #endif
 #if defined(VISP_HAVE_AFMA6)
   if (name == "afma6-real") {
     static vpRobotAfma6 driver;
     driver.init(vpAfma6::TOOL_CUSTOM, eMc);
-    return std::make_unique<VispRobot>(driver, vpHomogeneousMatrix(), name);
+    return std::make_unique<servo::VispRobot>(driver, vpHomogeneousMatrix(), name);
   }
 #endif
   (void)name;
@@ -107,7 +107,7 @@ class CommandLines {
   /// proposer of the target, the confirmed occluder tracks seen in the frame
   /// (id, position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
   void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,
-             const LoopStep* step = nullptr) {
+             const servo::LoopStep* step = nullptr) {
     if (!out_ || closed_) return;
     std::fprintf(out_, "{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
     for (unsigned i = 0; i < 6; ++i) std::fprintf(out_, "%s%.17g", i ? ", " : "", v[i]);
@@ -217,8 +217,8 @@ Command add_run_command(CLI::App& app) {
             const bool real = opt->robot.size() > 5 && opt->robot.compare(opt->robot.size() - 5, 5, "-real") == 0;
             EpisodeSetup setup;
             std::unique_ptr<FrameSource> source;
-            std::unique_ptr<CameraRobot> robot;
-            ObjectSelection selection;
+            std::unique_ptr<servo::CameraRobot> robot;
+            perception::ObjectSelection selection;
 #if defined(OFV_HAVE_DISPLAY)
             std::unique_ptr<LiveDisplay> display;
 #endif
@@ -259,14 +259,14 @@ Command add_run_command(CLI::App& app) {
                 }
                 setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
                 setup.real_time = true;
-                if (setup.robot == RobotKind::Camera) {
+                if (setup.robot == servo::RobotKind::Camera) {
                   throw std::invalid_argument("--source sim: needs --robot viper850 or afma6 (ViSP's threaded simulators)");
                 }
                 open_display();
               } else {
                 setup.duration = std::numeric_limits<double>::infinity();
                 episode_settings_table().apply(setup, settings);
-                (void)ViewLoop(setup.loop);  // validates
+                (void)servo::ViewLoop(setup.loop);  // validates
                 const bool select = std::any_of(settings.begin(), settings.end(), [](const auto& s) { return s.first == "select"; });
                 if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time || select) {
                   throw std::invalid_argument(
@@ -290,7 +290,7 @@ Command add_run_command(CLI::App& app) {
             try {
               CommandLines lines(opt->dry_run);
               bool user_quit = false;  // the display's quit, not a signal
-              const auto print = [&](const RobotLoopFrame& f) {
+              const auto print = [&](const servo::RobotLoopFrame& f) {
                 lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
                             to_string(f.step->safety), f.step);
 #if defined(OFV_HAVE_DISPLAY)
@@ -313,27 +313,27 @@ Command add_run_command(CLI::App& app) {
                           << episode_summary(outcome.metrics);
                 return kOk;
               }
-              RobotLoopOptions options;
+              servo::RobotLoopOptions options;
               options.pose_from_robot = options.wall_clock_age = opt->source.rfind("openni2://", 0) == 0;
               options.move_robot = !opt->dry_run || !real;  // simulated robots follow a dry run
               options.max_duration = setup.duration;
               options.stop = &g_stop;
-              PerceptionSettings front_end = front_end_settings(setup);
+              perception::PerceptionSettings front_end = front_end_settings(setup);
               front_end.selection = selection;
-              PerceptionObserver perception(front_end);
+              perception::PerceptionObserver perception(front_end);
               // A --box or --rect that selects nothing in the first frame
               // makes the run meaningless (every frame lost): stop and refuse.
               std::string selects_nothing;
-              const auto first_frame = [&](const RobotLoopFrame& f) {
+              const auto first_frame = [&](const servo::RobotLoopFrame& f) {
                 print(f);
-                if (f.index == 0 && selection.mode != ObjectSelection::Mode::Auto &&
-                    perception.last().status == TrackingStatus::Lost) {
+                if (f.index == 0 && selection.mode != perception::ObjectSelection::Mode::Auto &&
+                    perception.last().status == perception::TrackingStatus::Lost) {
                   selects_nothing = (opt->box.empty() ? "--rect " + opt->rect : "--box " + opt->box) +
                                     ": selects nothing in the first frame (" + perception.last().message + ")";
                   g_stop = 1;
                 }
               };
-              const RobotLoopSummary summary =
+              const servo::RobotLoopSummary summary =
                   run_on_robot(*source, perception, *robot, setup.loop, options, first_frame);
               lines.close();
               if (!selects_nothing.empty()) {

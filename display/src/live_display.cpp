@@ -224,7 +224,7 @@ struct LiveDisplay::Impl {
       }
       if (target && (*target - *centroid).norm() > 1e-9) {
         try {
-          FeatureSphereView s;
+          servo::FeatureSphereView s;
           s.build(to_visp(in.wMc).inverse(),
                   vpColVector{centroid->x(), centroid->y(), centroid->z()},
                   vpColVector{target->x(), target->y(), target->z()}, options.r_sphere);
@@ -241,7 +241,7 @@ struct LiveDisplay::Impl {
     } else if (in.step) {
       head += std::string("  ") + to_string(in.step->status);
     }
-    if (in.step && in.step->safety != SafetyAction::None)
+    if (in.step && in.step->safety != servo::SafetyAction::None)
       head += std::string("  safety: ") + to_string(in.step->safety);
     vpDisplay::displayText(camera, 14, 6, head, kText);
     if (feature_error.size() == 6) {
@@ -450,7 +450,7 @@ bool LiveDisplay::observe(const StepRecord& record, const StepDetail& detail) {
   return show(in);
 }
 
-bool LiveDisplay::observe(const RobotLoopFrame& f) {
+bool LiveDisplay::observe(const servo::RobotLoopFrame& f) {
   DisplayInput in;
   if (f.frame) {
     in.time = f.frame->timestamp;

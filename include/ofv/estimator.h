@@ -195,6 +195,10 @@ struct UsableInput {
 ///        centroid `centroid` and radius `r_sphere` (for baselines and metrics).
 [[nodiscard]] UsableInput usable_input(const ViewProblem& problem, const Eigen::Vector3d& centroid, double r_sphere);
 
+namespace detail {
+struct FieldAccess;
+}
+
 /**
  * \brief One frame's problem prepared once for every estimate and view score
  *        made on it: the usable supervoxels and occluders (spec §7), C and
@@ -210,10 +214,6 @@ struct UsableInput {
  * copyable; immutable once built, so calls on one field may run on several
  * threads.
  */
-namespace detail {
-struct FieldAccess;
-}
-
 class OcclusionField {
  public:
   /**
@@ -224,8 +224,8 @@ class OcclusionField {
    */
   OcclusionField(const ViewProblem& problem, double r_sphere);
   ~OcclusionField();
-  OcclusionField(OcclusionField&&) noexcept;
-  OcclusionField& operator=(OcclusionField&&) noexcept;
+  OcclusionField(OcclusionField&&) noexcept;             ///< moves the prepared data
+  OcclusionField& operator=(OcclusionField&&) noexcept;  ///< moves the prepared data
   OcclusionField(const OcclusionField&) = delete;
   OcclusionField& operator=(const OcclusionField&) = delete;
 

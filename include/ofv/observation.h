@@ -1,11 +1,11 @@
 /**
  * \file observation.h
- * \brief What one frame tells the per-frame policy (ofv::ViewLoop), and the
+ * \brief What one frame tells the per-frame policy (ofv::servo::ViewLoop), and the
  *        interface of whatever makes it from a frame: the perception front
- *        end (ofv::PerceptionObserver) or, in simulation, the ground truth
+ *        end (ofv::perception::PerceptionObserver) or, in simulation, the ground truth
  *        cut down to what a front end would give.
  *
- * Every driver (ofv::run_episode, ofv::run_on_robot) hands the loop an
+ * Every driver (ofv::run_episode, ofv::servo::run_on_robot) hands the loop an
  * Observation and nothing else: what the loop knows of the world comes
  * through here.
  */

@@ -2,7 +2,7 @@
  * \file view_methods.h
  * \brief View selection: ofv's estimator and what it is compared against.
  *
- * The closed loop (ofv::ViewLoop) picks the camera's target view with one of
+ * The closed loop (ofv::servo::ViewLoop) picks the camera's target view with one of
  * these methods:
  * - the occlusion-free view estimator (estimator.h, ESTIMATOR-SPEC);
  * - a static camera (never moves);
@@ -95,7 +95,7 @@ struct MostVisibleSettings {
 };
 
 /**
- * \brief A view that sees clearly more, nearby (ofv::ViewLoop's look-ahead climbs there): scores (score_view) the
+ * \brief A view that sees clearly more, nearby (ofv::servo::ViewLoop's look-ahead climbs there): scores (score_view) the
  *        current view, its 8 neighbours at `step_deg` around it and the
  *        `others`, all on the sphere, and returns the one that sees the
  *        largest fraction of the object, but the current view unless that

@@ -92,7 +92,7 @@ const TrajectoryColumns& trajectory_columns() {
     // A column is a number (an empty field: none) unless a record writes a
     // word there (status, safety: None writes nothing, so a record with an action).
     StepRecord words;
-    words.safety = SafetyAction::SpeedLimit;
+    words.safety = servo::SafetyAction::SpeedLimit;
     for (const auto& field : split(trajectory_csv_row(words), ',')) out.numeric.push_back(numeric_field(field));
     if (out.names.size() != out.numeric.size()) throw std::logic_error("trajectory.csv: header and row differ in length");
     return out;

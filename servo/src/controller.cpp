@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ofv {
+namespace ofv::servo {
 
 namespace {
 
@@ -138,4 +138,4 @@ vpColVector ViewController::update(const Eigen::Vector3d& tf, const Eigen::Vecto
   return saturate(v, settings_.max_linear_speed, settings_.max_angular_speed);
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

@@ -9,7 +9,7 @@
 #include <iostream>
 #include <stdexcept>
 
-namespace ofv {
+namespace ofv::servo {
 
 FeatureSphereView::FeatureSphereView() { init(); }
 
@@ -107,4 +107,4 @@ void FeatureSphereView::display(const vpCameraParameters& cam, const vpImage<vpR
   vpDisplay::displayCross(I, ip, 15, color, thickness);
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

@@ -26,7 +26,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace ofv {
+namespace ofv::servo {
 
 namespace {
 
@@ -344,4 +344,4 @@ std::unique_ptr<CameraRobot> make_robot(RobotKind kind, const vpHomogeneousMatri
   return std::make_unique<KinematicArm>(model, wMc_start);
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

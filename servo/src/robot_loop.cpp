@@ -6,7 +6,7 @@
 #include <chrono>
 #include <cmath>
 
-namespace ofv {
+namespace ofv::servo {
 
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,
@@ -70,4 +70,4 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
   return summary;
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

@@ -9,7 +9,7 @@
 #include <string>
 #include <utility>
 
-namespace ofv {
+namespace ofv::servo {
 
 const char* to_string(SafetyAction action) {
   switch (action) {
@@ -92,4 +92,4 @@ vpColVector SafetyFilter::filter(const vpColVector& v_in, const vpHomogeneousMat
   return v;
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

@@ -6,7 +6,7 @@
 
 #include <stdexcept>
 
-namespace ofv {
+namespace ofv::servo {
 
 vpHomogeneousMatrix to_visp(const Eigen::Isometry3d& m) {
   vpHomogeneousMatrix h;
@@ -48,4 +48,4 @@ vpHomogeneousMatrix target_pose(const Eigen::Vector3d& t, const Eigen::Vector3d&
   return to_visp(wMcd);
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

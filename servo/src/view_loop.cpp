@@ -13,7 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace ofv {
+namespace ofv::servo {
 
 namespace {
 
@@ -710,4 +710,4 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
   return out;
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

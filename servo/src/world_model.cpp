@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace ofv {
+namespace ofv::servo {
 
 const std::vector<OccluderTrack>& WorldModel::update(const Eigen::Matrix3Xd* seen, double dt) {
   const bool timed = std::isfinite(dt) && dt > 0.0;
@@ -72,4 +72,4 @@ Eigen::Matrix3Xd WorldModel::revealed_still(const TrackPositions& then) const {
   return still_occluders(still, min_speed_);
 }
 
-}  // namespace ofv
+}  // namespace ofv::servo

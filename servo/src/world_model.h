@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// Each track's id and position at some frame.
 using TrackPositions = std::vector<std::pair<int, Eigen::Vector3d>>;
@@ -54,4 +54,4 @@ class WorldModel {
   std::map<int, History> history_;  // of each current track, by id
 };
 
-}  // namespace ofv
+}  // namespace ofv::servo

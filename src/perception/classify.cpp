@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace {
 
@@ -256,4 +256,4 @@ void Perception::Impl::beyond_view(const RgbdFrame& frame, PerceptionResult& r) 
   for (std::size_t j = 0; j < added.size(); ++j) p.occluders.col(seen + static_cast<Eigen::Index>(j)) = added[j].second;
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ofv {
+namespace ofv::perception {
 
 void check_frame(const RgbdFrame& frame) {
   const CameraIntrinsics& k = frame.intrinsics;
@@ -139,4 +139,4 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
   }
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

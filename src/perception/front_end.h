@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace detail {
 
@@ -201,4 +201,4 @@ struct Perception::Impl {
   void hidden_vertices(ViewProblem& p, std::size_t seen) const;
 };
 
-}  // namespace ofv
+}  // namespace ofv::perception

@@ -11,7 +11,7 @@
 #include <map>
 #include <utility>
 
-namespace ofv {
+namespace ofv::perception {
 
 void Perception::Impl::split_by_labels(const RgbdFrame& frame) {
   const VoxelLabels cells(frame, settings.supervoxels.voxel_resolution, settings.cloud.pixel_stride, settings.max_depth);
@@ -77,4 +77,4 @@ std::vector<char> Perception::Impl::labelled_object(const PerceptionResult& r) {
   return object;
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

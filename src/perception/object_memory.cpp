@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 using detail::chroma;
 
@@ -446,4 +446,4 @@ void Perception::Impl::behind_occluders(const RgbdFrame& frame, PerceptionResult
   r.counts.presumed_voxels = memory.size() - before;
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

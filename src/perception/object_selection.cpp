@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace {
 
@@ -268,4 +268,4 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
   return object;
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

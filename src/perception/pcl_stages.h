@@ -10,7 +10,7 @@
 #include <optional>
 #include <vector>
 
-namespace ofv::detail {
+namespace ofv::perception::detail {
 
 /// Supervoxels of one frame and the voxels they own.
 struct SupervoxelOutput {
@@ -39,4 +39,4 @@ void cluster_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& sett
 [[nodiscard]] std::optional<Eigen::Vector4d> fit_dominant_plane(
     const std::vector<Eigen::Vector3f>& points, double distance, std::size_t min_inliers);
 
-}  // namespace ofv::detail
+}  // namespace ofv::perception::detail

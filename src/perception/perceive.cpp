@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
                          const EstimatorSettings& settings, long max_frames,
@@ -71,4 +71,4 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
   return summary;
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

@@ -13,7 +13,7 @@
 #include <fstream>
 #include <stdexcept>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace {
 
@@ -85,4 +85,4 @@ void write_perceived_frame(const std::string& dir, const PerceivedFrame& frame,
   }
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

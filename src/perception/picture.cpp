@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace {
 
@@ -271,4 +271,4 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
   }
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

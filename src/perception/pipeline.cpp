@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace {
 
@@ -156,4 +156,4 @@ void Perception::reset() {
 
 const PerceptionSettings& Perception::settings() const { return impl_->settings; }
 
-}  // namespace ofv
+}  // namespace ofv::perception

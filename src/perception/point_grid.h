@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace ofv::detail {
+namespace ofv::perception::detail {
 
 /// A grid cell's key: 21 bits per axis (+-8 km at 8 mm cells).
 inline std::uint64_t cell_key(const Eigen::Vector3i& c) {
@@ -80,4 +80,4 @@ class PointGrid {
   const std::vector<Eigen::Vector3f>* points_ = nullptr;
 };
 
-}  // namespace ofv::detail
+}  // namespace ofv::perception::detail

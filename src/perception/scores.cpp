@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-namespace ofv {
+namespace ofv::perception {
 
 namespace {
 
@@ -195,4 +195,4 @@ double labelled_shown_area(const RgbdFrame& frame, const PerceptionSettings& set
   return static_cast<double>(object) * voxel * voxel;
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

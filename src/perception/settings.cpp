@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ofv {
+namespace ofv::perception {
 
 Observation observation(const PerceptionResult& result, double voxel) {
   Observation o;
@@ -143,4 +143,4 @@ void validate(const PerceptionSettings& s) {
   }
 }
 
-}  // namespace ofv
+}  // namespace ofv::perception

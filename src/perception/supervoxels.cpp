@@ -13,7 +13,7 @@
 #include <cmath>
 #include <map>
 
-namespace ofv::detail {
+namespace ofv::perception::detail {
 
 void cluster_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& settings,
                          const Eigen::Vector3d& camera, SupervoxelOutput& out) {
@@ -126,4 +126,4 @@ std::optional<Eigen::Vector4d> fit_dominant_plane(const std::vector<Eigen::Vecto
   return plane / norm;
 }
 
-}  // namespace ofv::detail
+}  // namespace ofv::perception::detail

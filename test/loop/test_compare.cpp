@@ -46,7 +46,7 @@ EpisodeOutcome synthetic(const EpisodeSpec& spec) {
     s.time = 0.05 * static_cast<double>(k);
     s.occluders_in_sphere = s.time >= 0.3 ? 1 : 0;
     s.visible_fraction = (s.time >= 0.3 && s.time < 0.3 + recovery) ? 0.5 : 1.0;
-    s.status = StepStatus::Converged;
+    s.status = servo::StepStatus::Converged;
     s.times.estimate = 1e-5;
   }
   return {summarise(steps), steps, {}};

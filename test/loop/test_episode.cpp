@@ -39,7 +39,7 @@ TEST(Episode, KeepsTheObjectInViewOnTheDefaultScenario) {
   ASSERT_TRUE(m.max_recovery_time);
   EXPECT_LE(*m.max_recovery_time, 1.0);
   EXPECT_LE(m.max_sphere_distance_error, 0.02);  // the sphere feature keeps the camera on it
-  const ControllerSettings limits;
+  const servo::ControllerSettings limits;
   EXPECT_LE(m.max_linear_speed, limits.max_linear_speed + 1e-9);
   EXPECT_LE(m.max_angular_speed, limits.max_angular_speed + 1e-9);
   EXPECT_GT(m.path_length, 0.05);  // it moved away from the hand
@@ -94,7 +94,7 @@ TEST(Episode, FullPerceptionTracksTheScenariosObjectWhateverIsAtTheImageCentre) 
   };
   const EpisodeOutcome labels = run_full("labels");
   const EpisodeOutcome automatic = run_full("auto");
-  for (const StepRecord& s : labels.steps) EXPECT_NE(s.status, StepStatus::ObjectLost) << s.time;
+  for (const StepRecord& s : labels.steps) EXPECT_NE(s.status, servo::StepStatus::ObjectLost) << s.time;
   EXPECT_LE(labels.metrics.max_sphere_distance_error, 0.02);
   EXPECT_GT(automatic.metrics.max_sphere_distance_error, 0.1);
 }
@@ -143,36 +143,36 @@ TEST(Episode, EveryModeChangeIsATransitionOfTheTable) {
   const EpisodeOutcome o = run_episode(
       resolve_episode(sim::load_scenario("no-free-view"), {{"perception", "full"}, {"latency", "1"}}));
   const auto& table = loop_transitions();
-  const auto edge = [&](LoopMode from, Guard guard, LoopMode to) {
+  const auto edge = [&](servo::LoopMode from, servo::Guard guard, servo::LoopMode to) {
     return std::any_of(table.begin(), table.end(),
-                       [&](const LoopTransition& t) { return t.from == from && t.guard == guard && t.to == to; });
+                       [&](const servo::LoopTransition& t) { return t.from == from && t.guard == guard && t.to == to; });
   };
-  std::map<LoopMode, int> frames;
-  LoopMode before = LoopMode::Lost;  // a loop's mode before its first frame
+  std::map<servo::LoopMode, int> frames;
+  servo::LoopMode before = servo::LoopMode::Lost;  // a loop's mode before its first frame
   for (const StepRecord& s : o.steps) {
     ++frames[s.mode];
-    if (s.guard == Guard::None) {
+    if (s.guard == servo::Guard::None) {
       EXPECT_EQ(s.mode, before) << s.time;
     } else {
       bool path = edge(before, s.guard, s.mode);
-      for (const LoopTransition& first : table) {
-        const bool again = first.guard == Guard::ObjectFound || first.guard == Guard::ObjectLost;
+      for (const servo::LoopTransition& first : table) {
+        const bool again = first.guard == servo::Guard::ObjectFound || first.guard == servo::Guard::ObjectLost;
         path = path || (first.from == before && again && edge(first.to, s.guard, s.mode));
       }
       EXPECT_TRUE(path) << s.time << ": " << to_string(before) << " by " << to_string(s.guard) << " to "
                         << to_string(s.mode);
     }
     // Each mode's target comes from its proposers.
-    if (s.mode == LoopMode::Hold || s.mode == LoopMode::WayBack) {
-      EXPECT_EQ(s.proposer, Proposer::BestSeen) << s.time;
+    if (s.mode == servo::LoopMode::Hold || s.mode == servo::LoopMode::WayBack) {
+      EXPECT_EQ(s.proposer, servo::Proposer::BestSeen) << s.time;
     }
-    if (s.mode == LoopMode::Waiting || s.mode == LoopMode::Lost) {
-      EXPECT_EQ(s.proposer, Proposer::None) << s.time;
+    if (s.mode == servo::LoopMode::Waiting || s.mode == servo::LoopMode::Lost) {
+      EXPECT_EQ(s.proposer, servo::Proposer::None) << s.time;
     }
     before = s.mode;
   }
-  EXPECT_GT(frames[LoopMode::Hold], 0);
-  EXPECT_GT(frames[LoopMode::WayBack], 0);
+  EXPECT_GT(frames[servo::LoopMode::Hold], 0);
+  EXPECT_GT(frames[servo::LoopMode::WayBack], 0);
 }
 
 TEST(Episode, SettingsAreValidatedByName) {

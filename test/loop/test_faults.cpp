@@ -1,5 +1,5 @@
 // Faults in the closed loop. A recorded simulated episode (TUM files written
-// by run_episode's frames) is replayed through ofv::run_on_robot with faults
+// by run_episode's frames) is replayed through ofv::servo::run_on_robot with faults
 // injected between the source and the loop (FaultySource) and between the
 // loop and the robot (FaultyRobot); every command the robot receives is
 // checked against the safety invariants (check_invariants). End to end,
@@ -142,17 +142,17 @@ class FaultySource : public FrameSource {
 
 /// A CameraRobot that records every command and throws at command `fail_at`
 /// (once, or on every command from then on when it `refuses`).
-class FaultyRobot : public CameraRobot {
+class FaultyRobot : public servo::CameraRobot {
  public:
   struct Command {
     vpColVector v;
     double dt;
     bool after_stop;  ///< the stop flag was up when it was sent
   };
-  FaultyRobot(CameraRobot& inner, long fail_at, bool refuses, const volatile std::sig_atomic_t* stop)
+  FaultyRobot(servo::CameraRobot& inner, long fail_at, bool refuses, const volatile std::sig_atomic_t* stop)
       : inner_(inner), fail_at_(fail_at), refuses_(refuses), stop_(stop) {}
   [[nodiscard]] vpHomogeneousMatrix wMc() const override { return inner_.wMc(); }
-  RobotStep step(const vpColVector& v, double dt) override {
+  servo::RobotStep step(const vpColVector& v, double dt) override {
     const long n = static_cast<long>(commands_.size());
     commands_.push_back({v, dt, *stop_ != 0});
     if (n == fail_at_ || (refuses_ && fail_at_ >= 0 && n > fail_at_)) {
@@ -164,7 +164,7 @@ class FaultyRobot : public CameraRobot {
   [[nodiscard]] const std::vector<Command>& commands() const { return commands_; }
 
  private:
-  CameraRobot& inner_;
+  servo::CameraRobot& inner_;
   long fail_at_;
   bool refuses_;
   const volatile std::sig_atomic_t* stop_;
@@ -175,9 +175,9 @@ class FaultyRobot : public CameraRobot {
 struct FaultRun {
   std::vector<FaultyRobot::Command> commands;
   std::vector<FaultySource::Delivered> delivered;
-  std::vector<SafetyAction> actions;  ///< per frame the loop finished
-  std::vector<StepStatus> statuses;
-  RobotLoopSummary summary;
+  std::vector<servo::SafetyAction> actions;  ///< per frame the loop finished
+  std::vector<servo::StepStatus> statuses;
+  servo::RobotLoopSummary summary;
   std::optional<std::string> error;  ///< what run_on_robot threw
 };
 
@@ -194,15 +194,15 @@ FaultRun replay(const FaultPlan& plan) {
   TumSequenceSource files(rec.dir.string());
   volatile std::sig_atomic_t stop = 0;
   FaultySource source(files, plan.source, &stop);
-  FreeFlyingCamera camera{vpHomogeneousMatrix()};
+  servo::FreeFlyingCamera camera{vpHomogeneousMatrix()};
   FaultyRobot robot(camera, plan.robot_fails_at, plan.robot_refuses, &stop);
-  RobotLoopOptions options;
+  servo::RobotLoopOptions options;
   options.stop = &stop;
   options.max_duration = plan.max_duration;
   FaultRun out;
   try {
-    PerceptionObserver perception(front_end_settings(rec.setup));
-    out.summary = run_on_robot(source, perception, robot, rec.setup.loop, options, [&](const RobotLoopFrame& f) {
+    perception::PerceptionObserver perception(front_end_settings(rec.setup));
+    out.summary = run_on_robot(source, perception, robot, rec.setup.loop, options, [&](const servo::RobotLoopFrame& f) {
       out.actions.push_back(f.step->safety);
       out.statuses.push_back(f.step->status);
       if (f.index == plan.observer_throws_at) throw std::runtime_error("observer fault");
@@ -232,7 +232,7 @@ bool is_zero(const vpColVector& v) { return v.frobeniusNorm() == 0.0; }
  *  5. the last command is zero (every exit path leaves the robot at rest);
  *  6. nothing but zero once the stop flag is up.
  */
-void check_invariants(const FaultRun& run, const SafetySettings& limits) {
+void check_invariants(const FaultRun& run, const servo::SafetySettings& limits) {
   constexpr double eps = 1e-9;
   ASSERT_FALSE(run.commands.empty());
   vpColVector previous(6, 0.0);
@@ -262,9 +262,9 @@ void check_invariants(const FaultRun& run, const SafetySettings& limits) {
   }
 }
 
-const SafetySettings& limits() { return recording().setup.loop.safety; }
+const servo::SafetySettings& limits() { return recording().setup.loop.safety; }
 
-std::size_t count(const std::vector<SafetyAction>& actions, SafetyAction a) {
+std::size_t count(const std::vector<servo::SafetyAction>& actions, servo::SafetyAction a) {
   return static_cast<std::size_t>(std::count(actions.begin(), actions.end(), a));
 }
 
@@ -288,7 +288,7 @@ TEST(Faults, SimulatedEpisodeKeepsTheSpeedAndAccelerationLimits) {
     vpColVector v(6);
     for (unsigned i = 0; i < 6; ++i) v[i] = s.velocity(i);
     r.commands.push_back({v, 1.0 / recording().setup.scenario.rate, false});
-    if (s.status == StepStatus::ObjectLost) {
+    if (s.status == servo::StepStatus::ObjectLost) {
       EXPECT_TRUE(is_zero(v)) << s.time;
     }
   }
@@ -304,8 +304,8 @@ TEST(Faults, DroppedFramesStopTheRobotOnceTheGapIsStale) {
   const FaultRun r = replay(plan);
   EXPECT_FALSE(r.error);
   check_invariants(r, limits());
-  EXPECT_EQ(count(r.actions, SafetyAction::StaleFrame), 1U);
-  EXPECT_EQ(r.actions.at(12 - 1), SafetyAction::StaleFrame);  // one frame dropped before
+  EXPECT_EQ(count(r.actions, servo::SafetyAction::StaleFrame), 1U);
+  EXPECT_EQ(r.actions.at(12 - 1), servo::SafetyAction::StaleFrame);  // one frame dropped before
 }
 
 TEST(Faults, FramesWithoutDepthLoseTheObjectUntilItIsFoundAgain) {
@@ -315,13 +315,13 @@ TEST(Faults, FramesWithoutDepthLoseTheObjectUntilItIsFoundAgain) {
   EXPECT_FALSE(r.error);
   check_invariants(r, limits());
   for (std::size_t k = 6; k <= 9; ++k) {
-    EXPECT_EQ(r.statuses.at(k), StepStatus::ObjectLost) << k;
-    EXPECT_EQ(r.actions.at(k), SafetyAction::ObjectLost) << k;
+    EXPECT_EQ(r.statuses.at(k), servo::StepStatus::ObjectLost) << k;
+    EXPECT_EQ(r.actions.at(k), servo::SafetyAction::ObjectLost) << k;
   }
   // Found again: tracked and moving before the end.
   bool found = false;
   for (std::size_t k = 10; k < r.statuses.size(); ++k) {
-    found = found || (r.statuses[k] != StepStatus::ObjectLost && !is_zero(r.commands[k].v));
+    found = found || (r.statuses[k] != servo::StepStatus::ObjectLost && !is_zero(r.commands[k].v));
   }
   EXPECT_TRUE(found);
 }
@@ -333,7 +333,7 @@ TEST(Faults, TimestampGapsAndJumpsBackwardsStopTheRobot) {
   const FaultRun r = replay(plan);
   EXPECT_FALSE(r.error);
   check_invariants(r, limits());
-  EXPECT_EQ(r.actions.at(5), SafetyAction::StaleFrame);
+  EXPECT_EQ(r.actions.at(5), servo::SafetyAction::StaleFrame);
   EXPECT_TRUE(stops(r.actions.at(10)));
   EXPECT_TRUE(stops(r.actions.at(15)));
   EXPECT_TRUE(stops(r.actions.at(20)));

@@ -17,7 +17,7 @@ std::vector<StepRecord> episode(const std::vector<double>& visible, const std::v
     steps[k].visible_fraction = visible[k];
     steps[k].occluders_in_sphere = occluders[k];
     steps[k].wMc.translation() = Eigen::Vector3d(0.01 * static_cast<double>(k), 0, 0);
-    steps[k].status = k % 2 ? StepStatus::Converged : StepStatus::NoOccluders;
+    steps[k].status = k % 2 ? servo::StepStatus::Converged : servo::StepStatus::NoOccluders;
   }
   return steps;
 }
@@ -108,7 +108,7 @@ TEST(Metrics, EmptyAndSingleStepEpisodes) {
 TEST(Metrics, TrajectoryRowMatchesTheHeader) {
   StepRecord s;
   s.tf = Eigen::Vector3d(1, 2, 3);
-  s.status = StepStatus::Converged;
+  s.status = servo::StepStatus::Converged;
   const auto count = [](const std::string& line) { return std::count(line.begin(), line.end(), ','); };
   EXPECT_EQ(count(trajectory_csv_row(s)), count(trajectory_csv_header()));
 }

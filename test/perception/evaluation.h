@@ -11,7 +11,7 @@ namespace ofv::test {
 
 /// Majority ground-truth label of each supervoxel: its voxels projected into
 /// the frame's camera and looked up in `labels` (width x height).
-inline std::vector<int> supervoxel_truth(const PerceptionResult& r, const RgbdFrame& frame,
+inline std::vector<int> supervoxel_truth(const perception::PerceptionResult& r, const RgbdFrame& frame,
                                          const std::vector<int>& labels) {
   std::vector<std::map<int, int>> votes(r.supervoxels.size());
   const Eigen::Isometry3d cMw = frame.wMc.inverse();
@@ -43,7 +43,7 @@ inline std::vector<int> supervoxel_truth(const PerceptionResult& r, const RgbdFr
 
 /// Mean of the voxels whose pixel carries ground-truth label `label`: the
 /// centroid a perfect segmentation of this frame's voxels would give.
-inline Eigen::Vector3d truth_centroid(const PerceptionResult& r, const RgbdFrame& frame,
+inline Eigen::Vector3d truth_centroid(const perception::PerceptionResult& r, const RgbdFrame& frame,
                                       const std::vector<int>& labels, int label) {
   const Eigen::Isometry3d cMw = frame.wMc.inverse();
   const CameraIntrinsics& k = frame.intrinsics;
@@ -71,11 +71,11 @@ struct ObjectScore {
   int actual = 0;
 };
 
-inline ObjectScore score_object(const PerceptionResult& r, const std::vector<int>& truth,
+inline ObjectScore score_object(const perception::PerceptionResult& r, const std::vector<int>& truth,
                                 int object) {
   ObjectScore s;
   for (std::size_t i = 0; i < truth.size(); ++i) {
-    const bool predicted = r.supervoxels[i].label == SupervoxelClass::Object;
+    const bool predicted = r.supervoxels[i].label == perception::SupervoxelClass::Object;
     const bool actual = truth[i] == object;
     s.predicted += predicted ? 1 : 0;
     s.actual += actual ? 1 : 0;
@@ -87,8 +87,8 @@ inline ObjectScore score_object(const PerceptionResult& r, const std::vector<int
 }
 
 /// How many supervoxels with ground-truth label `label` got class `cls`.
-inline int count_truth_as(const PerceptionResult& r, const std::vector<int>& truth, int label,
-                          SupervoxelClass cls) {
+inline int count_truth_as(const perception::PerceptionResult& r, const std::vector<int>& truth, int label,
+                          perception::SupervoxelClass cls) {
   int n = 0;
   for (std::size_t i = 0; i < truth.size(); ++i) {
     n += truth[i] == label && r.supervoxels[i].label == cls ? 1 : 0;

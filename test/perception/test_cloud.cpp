@@ -26,12 +26,12 @@ TEST(CloudBuilder, BackProjectsPixelsWithTheViSPConvention) {
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
   wMc.translation() = Eigen::Vector3d(1.0, 2.0, 3.0);
   f.wMc = wMc;
-  CloudSettings s;
+  perception::CloudSettings s;
   s.pixel_stride = 1;
   s.voxel_resolution = 0.0;  // every point
-  CloudBuilder builder(s);
-  WorldCloud cloud;
-  builder.build(f, CropVolume{}, cloud);
+  perception::CloudBuilder builder(s);
+  perception::WorldCloud cloud;
+  builder.build(f, perception::CropVolume{}, cloud);
   ASSERT_EQ(cloud.points.size(), f.depth.size());
   // Pixel (u, v) = (0, 0): X = (0 - cx) Z / fx, left and up (negative) of the axis.
   const CameraIntrinsics& k = f.intrinsics;
@@ -49,12 +49,12 @@ TEST(CloudBuilder, DropsZeroAndNanDepth) {
   f.depth[1] = std::numeric_limits<float>::quiet_NaN();
   f.depth[2] = -1.0f;
   f.depth[3] = std::numeric_limits<float>::infinity();
-  CloudSettings s;
+  perception::CloudSettings s;
   s.pixel_stride = 1;
   s.voxel_resolution = 0.0;
-  CloudBuilder builder(s);
-  WorldCloud cloud;
-  builder.build(f, CropVolume{}, cloud);
+  perception::CloudBuilder builder(s);
+  perception::WorldCloud cloud;
+  builder.build(f, perception::CropVolume{}, cloud);
   EXPECT_EQ(cloud.points.size(), f.depth.size() - 4);
   EXPECT_EQ(cloud.valid_pixels, f.depth.size() - 4);
   for (const auto& p : cloud.points) {
@@ -64,12 +64,12 @@ TEST(CloudBuilder, DropsZeroAndNanDepth) {
 
 TEST(CloudBuilder, CropsToSphereBoxAndDepth) {
   const RgbdFrame f = wall(1.0);
-  CloudSettings s;
+  perception::CloudSettings s;
   s.pixel_stride = 1;
   s.voxel_resolution = 0.0;
-  CloudBuilder builder(s);
-  WorldCloud cloud;
-  CropVolume sphere;
+  perception::CloudBuilder builder(s);
+  perception::WorldCloud cloud;
+  perception::CropVolume sphere;
   sphere.centre = Eigen::Vector3d(0.0, 0.0, 1.0);
   sphere.radius = 0.1;
   builder.build(f, sphere, cloud);
@@ -81,14 +81,14 @@ TEST(CloudBuilder, CropsToSphereBoxAndDepth) {
   const double expected = kPi * std::pow(0.1 * f.intrinsics.fx, 2);
   EXPECT_NEAR(static_cast<double>(cloud.points.size()), expected, 0.03 * expected);
 
-  CropVolume box;
+  perception::CropVolume box;
   box.box = Eigen::AlignedBox3d(Eigen::Vector3d(0.0, 0.0, 0.5), Eigen::Vector3d(0.2, 0.1, 1.5));
   builder.build(f, box, cloud);
   ASSERT_FALSE(cloud.points.empty());
   for (const auto& p : cloud.points) {
     ASSERT_TRUE(box.box.contains(p.cast<double>()));
   }
-  CropVolume near;
+  perception::CropVolume near;
   near.max_depth = 0.9;
   builder.build(f, near, cloud);
   EXPECT_TRUE(cloud.points.empty());
@@ -97,12 +97,12 @@ TEST(CloudBuilder, CropsToSphereBoxAndDepth) {
 
 TEST(CloudBuilder, VoxelisesToOnePointPerOccupiedVoxel) {
   const RgbdFrame f = wall(0.5);
-  CloudSettings s;
+  perception::CloudSettings s;
   s.pixel_stride = 1;
   s.voxel_resolution = 0.01;
-  CloudBuilder builder(s);
-  WorldCloud cloud;
-  builder.build(f, CropVolume{}, cloud);
+  perception::CloudBuilder builder(s);
+  perception::WorldCloud cloud;
+  builder.build(f, perception::CropVolume{}, cloud);
   // The wall spans 320/fx*0.5 x 240/fy*0.5 m at 1 cm voxels.
   const double w = 320.0 / f.intrinsics.fx * 0.5 / 0.01;
   const double h = 240.0 / f.intrinsics.fy * 0.5 / 0.01;
@@ -112,23 +112,23 @@ TEST(CloudBuilder, VoxelisesToOnePointPerOccupiedVoxel) {
     EXPECT_NEAR(cloud.colours[i].x(), 100.0f, 1e-3f);
   }
   // Reuse: the same frame twice gives the same cloud.
-  WorldCloud again;
-  builder.build(f, CropVolume{}, again);
+  perception::WorldCloud again;
+  builder.build(f, perception::CropVolume{}, again);
   EXPECT_EQ(again.points.size(), cloud.points.size());
 }
 
 TEST(CloudBuilder, RejectsBuffersThatDisagreeWithTheIntrinsics) {
   RgbdFrame f = wall(1.0);
   f.depth.pop_back();
-  CloudBuilder builder;
-  WorldCloud cloud;
-  EXPECT_THROW(builder.build(f, CropVolume{}, cloud), std::invalid_argument);
+  perception::CloudBuilder builder;
+  perception::WorldCloud cloud;
+  EXPECT_THROW(builder.build(f, perception::CropVolume{}, cloud), std::invalid_argument);
   f = wall(1.0);
   f.rgb.resize(5);
-  EXPECT_THROW(builder.build(f, CropVolume{}, cloud), std::invalid_argument);
-  CloudSettings bad;
+  EXPECT_THROW(builder.build(f, perception::CropVolume{}, cloud), std::invalid_argument);
+  perception::CloudSettings bad;
   bad.pixel_stride = 0;
-  EXPECT_THROW(CloudBuilder{bad}, std::invalid_argument);
+  EXPECT_THROW(perception::CloudBuilder{bad}, std::invalid_argument);
 }
 
 }  // namespace

@@ -56,11 +56,11 @@ std::vector<RgbdFrame> sequence() {
               nullptr, 0.3)};
 }
 
-std::vector<PerceivedFrame> perceive_all(FrameSource& source, long max_frames,
-                                         PerceiveSummary* summary = nullptr) {
-  std::vector<PerceivedFrame> seen;
-  const PerceiveSummary s = perceive(source, PerceptionSettings{}, EstimatorSettings{}, max_frames,
-                                     [&seen](const PerceivedFrame& f) { seen.push_back(f); });
+std::vector<perception::PerceivedFrame> perceive_all(FrameSource& source, long max_frames,
+                                         perception::PerceiveSummary* summary = nullptr) {
+  std::vector<perception::PerceivedFrame> seen;
+  const perception::PerceiveSummary s = perceive(source, perception::PerceptionSettings{}, EstimatorSettings{}, max_frames,
+                                     [&seen](const perception::PerceivedFrame& f) { seen.push_back(f); });
   if (summary != nullptr) {
     *summary = s;
   }
@@ -70,7 +70,7 @@ std::vector<PerceivedFrame> perceive_all(FrameSource& source, long max_frames,
 TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {
   const auto frames = sequence();
   VectorSource source(frames);
-  PerceiveSummary summary;
+  perception::PerceiveSummary summary;
   const auto seen = perceive_all(source, -1, &summary);
   ASSERT_EQ(seen.size(), frames.size());
   EXPECT_EQ(summary.frames, 4);
@@ -78,18 +78,18 @@ TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {
 
   // The same front end run by hand, and the estimator on its problem with
   // the previous estimate's t_f.
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   std::optional<Eigen::Vector3d> previous_view;
   std::vector<double> front_end;
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const PerceivedFrame& f = seen[k];
+    const perception::PerceivedFrame& f = seen[k];
     EXPECT_EQ(f.index, static_cast<long>(k));
     EXPECT_EQ(f.frame.timestamp, frames[k].timestamp);
-    const PerceptionResult r = perception.process(frames[k]);
+    const perception::PerceptionResult r = perception.process(frames[k]);
     ASSERT_EQ(f.result.status, r.status) << "frame " << k;
     EXPECT_EQ(f.result.counts.object, r.counts.object) << "frame " << k;
     front_end.push_back(f.result.timings.total);
-    if (r.status == TrackingStatus::Lost) {
+    if (r.status == perception::TrackingStatus::Lost) {
       EXPECT_FALSE(f.estimate) << "frame " << k;
       EXPECT_EQ(f.estimate_ms, 0.0);
       continue;
@@ -107,7 +107,7 @@ TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {
     EXPECT_TRUE(f.estimate->tf.isApprox(e.tf, 1e-12)) << "frame " << k;
     previous_view = e.tf;
   }
-  EXPECT_EQ(seen[1].result.status, TrackingStatus::Lost);
+  EXPECT_EQ(seen[1].result.status, perception::TrackingStatus::Lost);
   // Frame 2 starts from frame 0's view: the lost frame does not forget it.
   ASSERT_TRUE(seen[2].result.problem.previous_view);
   EXPECT_EQ(*seen[2].result.problem.previous_view, seen[0].estimate->tf);
@@ -117,7 +117,7 @@ TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {
 
 TEST(Perceive, StopsAfterMaxFramesAndLeavesTheRestInTheSource) {
   VectorSource source(sequence());
-  PerceiveSummary summary;
+  perception::PerceiveSummary summary;
   EXPECT_EQ(perceive_all(source, 2, &summary).size(), 2u);
   EXPECT_EQ(summary.frames, 2);
   EXPECT_EQ(summary.lost, 1);
@@ -133,7 +133,7 @@ TEST(Perceive, StopsAfterMaxFramesAndLeavesTheRestInTheSource) {
 
 TEST(Perceive, RejectsInvalidSettingsBeforeReadingAFrame) {
   VectorSource source(sequence());
-  PerceptionSettings ps;
+  perception::PerceptionSettings ps;
   ps.supervoxels.voxel_resolution = -1.0;
   EXPECT_THROW((void)perceive(source, ps, EstimatorSettings{}, -1, nullptr), std::invalid_argument);
   EXPECT_TRUE(source.next());

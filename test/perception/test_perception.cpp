@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <type_traits>
 #include <cmath>
 
 namespace ofv {
@@ -44,17 +45,17 @@ test::Shape arm_in_front() {
 }
 
 TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const Frame f = render(test::table_and_case(), test::front_camera());
-  const PerceptionResult r = perception.process(f.frame);
-  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  const perception::PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
   const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
   const auto score = test::score_object(r, truth, kObject);
   EXPECT_GE(score.precision, 0.95) << score.true_positives << "/" << score.predicted;
   EXPECT_GE(score.recall, 0.90) << score.true_positives << "/" << score.actual;
   EXPECT_LE((r.centroid - kFrontFace).norm(), 0.01) << r.centroid.transpose();
   // The table is not object; inside the sphere and outside the OBB it is an occluder.
-  EXPECT_EQ(test::count_truth_as(r, truth, kTable, SupervoxelClass::Object), 0);
+  EXPECT_EQ(test::count_truth_as(r, truth, kTable, perception::SupervoxelClass::Object), 0);
   EXPECT_GT(r.counts.occluders, 0u);
   // PCA: e1 along the case's long side (world x), e3 its thin side (world y).
   EXPECT_GT(std::abs(r.axes.col(0).dot(Eigen::Vector3d::UnitX())), 0.95);
@@ -63,7 +64,7 @@ TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
   // The augmented OBB holds every object voxel.
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     if (r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label ==
-        SupervoxelClass::Object) {
+        perception::SupervoxelClass::Object) {
       ASSERT_TRUE(r.obb.contains(r.voxels[i].cast<double>()));
     }
   }
@@ -73,38 +74,38 @@ TEST(Perception, SupportPlaneCanBeLeftOutOfTheOccluders) {
   const Eigen::Isometry3d wMc = test::front_camera();
   test::SyntheticScene scene = test::table_and_case();
   scene.shapes.push_back(arm_in_front());
-  PerceptionSettings without;
+  perception::PerceptionSettings without;
   without.support_plane_occludes = false;
-  Perception paper{PerceptionSettings{}};
-  Perception no_table{without};
+  perception::Perception paper{perception::PerceptionSettings{}};
+  perception::Perception no_table{without};
   const Frame f = render(scene, wMc);
-  const PerceptionResult a = paper.process(f.frame);
-  const PerceptionResult b = no_table.process(f.frame);
-  ASSERT_EQ(a.status, TrackingStatus::Initialised);
-  ASSERT_EQ(b.status, TrackingStatus::Initialised);
+  const perception::PerceptionResult a = paper.process(f.frame);
+  const perception::PerceptionResult b = no_table.process(f.frame);
+  ASSERT_EQ(a.status, perception::TrackingStatus::Initialised);
+  ASSERT_EQ(b.status, perception::TrackingStatus::Initialised);
   const auto ta = test::supervoxel_truth(a, f.frame, f.labels);
   const auto tb = test::supervoxel_truth(b, f.frame, f.labels);
-  EXPECT_GT(test::count_truth_as(a, ta, kTable, SupervoxelClass::Occluder), 100);
+  EXPECT_GT(test::count_truth_as(a, ta, kTable, perception::SupervoxelClass::Occluder), 100);
   // Table supervoxels off the plane fit (the tabletop's edges) may remain.
-  EXPECT_LT(test::count_truth_as(b, tb, kTable, SupervoxelClass::Occluder),
-            test::count_truth_as(a, ta, kTable, SupervoxelClass::Occluder) / 10);
-  EXPECT_EQ(test::count_truth_as(b, tb, kHand, SupervoxelClass::Occluder),
-            test::count_truth_as(a, ta, kHand, SupervoxelClass::Occluder));
-  EXPECT_GE(test::count_truth_as(b, tb, kHand, SupervoxelClass::Occluder), 3);
+  EXPECT_LT(test::count_truth_as(b, tb, kTable, perception::SupervoxelClass::Occluder),
+            test::count_truth_as(a, ta, kTable, perception::SupervoxelClass::Occluder) / 10);
+  EXPECT_EQ(test::count_truth_as(b, tb, kHand, perception::SupervoxelClass::Occluder),
+            test::count_truth_as(a, ta, kHand, perception::SupervoxelClass::Occluder));
+  EXPECT_GE(test::count_truth_as(b, tb, kHand, perception::SupervoxelClass::Occluder), 3);
 }
 
 TEST(Perception, NormalsFaceTheCameraAndAdjacencyRespectsRadius) {
-  PerceptionSettings settings;
-  Perception perception{settings};
+  perception::PerceptionSettings settings;
+  perception::Perception perception{settings};
   const Eigen::Isometry3d wMc = test::front_camera();
   const Frame f = render(test::table_and_case(), wMc);
-  const PerceptionResult r = perception.process(f.frame);
-  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  const perception::PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
   int facing_front = 0;
-  for (const SupervoxelInfo& s : r.supervoxels) {
+  for (const perception::SupervoxelInfo& s : r.supervoxels) {
     ASSERT_NEAR(s.normal.norm(), 1.0, 1e-9);
     ASSERT_GE(s.normal.dot(wMc.translation() - s.centroid), 0.0);
-    if (s.label == SupervoxelClass::Object && s.normal.dot(-Eigen::Vector3d::UnitY()) > 0.9) {
+    if (s.label == perception::SupervoxelClass::Object && s.normal.dot(-Eigen::Vector3d::UnitY()) > 0.9) {
       ++facing_front;
     }
   }
@@ -131,23 +132,23 @@ class HandHolding : public testing::TestWithParam<int> {};
 
 TEST_P(HandHolding, HandIsInteractingNotObject) {
   const int width = GetParam();
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
   ASSERT_EQ(perception.process(render(test::table_and_case(), wMc, width).frame).status,
-            TrackingStatus::Initialised);
+            perception::TrackingStatus::Initialised);
   // The hand comes in from the right, 1 cm per frame, and grips the edge.
-  PerceptionResult r;
+  perception::PerceptionResult r;
   Frame f;
   for (int step = 5; step >= 0; --step) {
     test::SyntheticScene scene = test::table_and_case();
     scene.shapes.push_back(holding_hand(0.01 * step));
     f = render(scene, wMc, width);
     r = perception.process(f.frame);
-    ASSERT_EQ(r.status, TrackingStatus::Tracking) << "step " << step << ": " << r.message;
+    ASSERT_EQ(r.status, perception::TrackingStatus::Tracking) << "step " << step << ": " << r.message;
   }
   const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
-  EXPECT_EQ(test::count_truth_as(r, truth, kHand, SupervoxelClass::Object), 0);
-  EXPECT_GE(test::count_truth_as(r, truth, kHand, SupervoxelClass::Interacting), 1);
+  EXPECT_EQ(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Object), 0);
+  EXPECT_GE(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Interacting), 1);
   const auto score = test::score_object(r, truth, kObject);
   EXPECT_GE(score.precision, 0.95);
   EXPECT_GE(score.recall, 0.90);
@@ -157,19 +158,19 @@ TEST_P(HandHolding, HandIsInteractingNotObject) {
 INSTANTIATE_TEST_SUITE_P(Perception, HandHolding, testing::Values(640, 320));
 
 TEST(Perception, ArmInFrontIsAnOccluderAndMovesTheView) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
-  const PerceptionResult clear = perception.process(render(test::table_and_case(), wMc).frame);
-  ASSERT_EQ(clear.status, TrackingStatus::Initialised);
+  const perception::PerceptionResult clear = perception.process(render(test::table_and_case(), wMc).frame);
+  ASSERT_EQ(clear.status, perception::TrackingStatus::Initialised);
   test::SyntheticScene scene = test::table_and_case();
   scene.shapes.push_back(arm_in_front());
   const Frame f = render(scene, wMc);
-  const PerceptionResult r = perception.process(f.frame);
-  ASSERT_EQ(r.status, TrackingStatus::Tracking) << r.message;
+  const perception::PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Tracking) << r.message;
   const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
-  const int arm_occluders = test::count_truth_as(r, truth, kHand, SupervoxelClass::Occluder);
+  const int arm_occluders = test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Occluder);
   EXPECT_GE(arm_occluders, 3);
-  EXPECT_EQ(test::count_truth_as(r, truth, kHand, SupervoxelClass::Object), 0);
+  EXPECT_EQ(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Object), 0);
   // The arm hides part of the case: fewer object supervoxels than in the clear frame.
   EXPECT_LT(r.counts.object, clear.counts.object);
   const ViewEstimate e = estimate_view(r.problem, EstimatorSettings{});
@@ -193,16 +194,16 @@ TEST(Perception, AnArmTheImageBorderCutsGoesOnBeyondIt) {
   const Frame clear = render(scene, wMc);
   scene.shapes.push_back(test::make_capsule(elbow, wrist, radius, kSkin, kHand));
   const Frame f = render(scene, wMc);
-  PerceptionSettings off;
+  perception::PerceptionSettings off;
   off.beyond_view = false;
-  Perception with{PerceptionSettings{}}, without{off};
+  perception::Perception with{perception::PerceptionSettings{}}, without{off};
   // The table alone, cut by every border, is not continued: it is the support plane.
-  ASSERT_EQ(with.process(clear.frame).status, TrackingStatus::Initialised);
-  ASSERT_EQ(without.process(clear.frame).status, TrackingStatus::Initialised);
-  const PerceptionResult r = with.process(f.frame);
-  const PerceptionResult plain = without.process(f.frame);
-  ASSERT_EQ(r.status, TrackingStatus::Tracking) << r.message;
-  ASSERT_EQ(plain.status, TrackingStatus::Tracking) << plain.message;
+  ASSERT_EQ(with.process(clear.frame).status, perception::TrackingStatus::Initialised);
+  ASSERT_EQ(without.process(clear.frame).status, perception::TrackingStatus::Initialised);
+  const perception::PerceptionResult r = with.process(f.frame);
+  const perception::PerceptionResult plain = without.process(f.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Tracking) << r.message;
+  ASSERT_EQ(plain.status, perception::TrackingStatus::Tracking) << plain.message;
   EXPECT_EQ(plain.counts.beyond_view, 0u);
   EXPECT_EQ(static_cast<std::size_t>(plain.problem.occluders.cols()), plain.counts.occluders);
   // The frame's own occluders come first, then the continuation.
@@ -218,7 +219,7 @@ TEST(Perception, AnArmTheImageBorderCutsGoesOnBeyondIt) {
     EXPECT_LE(to_segment(q, elbow, wrist), radius + 0.02) << q.transpose();
     const Eigen::Vector3d qc = cMw * q;
     EXPECT_LT(k.fx * qc.x() / qc.z() + k.cx, 0.0) << q.transpose();
-    EXPECT_LT((q - r.centroid).norm(), PerceptionSettings{}.r_sphere);
+    EXPECT_LT((q - r.centroid).norm(), perception::PerceptionSettings{}.r_sphere);
     leftmost = std::min(leftmost, q.x());
   }
   // It reaches the sphere: C is near the case, the arm leaves the sphere at x = -0.45.
@@ -226,7 +227,7 @@ TEST(Perception, AnArmTheImageBorderCutsGoesOnBeyondIt) {
 }
 
 TEST(Perception, FollowsAMovingDeformingObject) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
   for (int k = 0; k <= 12; ++k) {
     // Slides 6 mm per frame to the right and stretches 1 % per frame.
@@ -244,8 +245,8 @@ TEST(Perception, FollowsAMovingDeformingObject) {
       scene.shapes.pop_back();  // frame 0 sees the whole object
     }
     const Frame f = render(scene, wMc);
-    const PerceptionResult r = perception.process(f.frame);
-    ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k << ": " << r.message;
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << r.message;
     const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
     const auto score = test::score_object(r, truth, kObject);
     EXPECT_GE(score.precision, 0.95) << "frame " << k;
@@ -259,7 +260,7 @@ TEST(Perception, NoisyDepthKeepsTheObjectAndTheHandApart) {
   // 1 mm at 1 m (growing with Z^2) and half the depth-edge pixels missing,
   // as the simulator's sensor model.
   for (const int width : {640, 320}) {
-    Perception perception{PerceptionSettings{}};
+    perception::Perception perception{perception::PerceptionSettings{}};
     const Eigen::Isometry3d wMc = test::front_camera();
     for (int k = 0; k < 6; ++k) {
       test::SyntheticScene scene = test::table_and_case();
@@ -268,13 +269,13 @@ TEST(Perception, NoisyDepthKeepsTheObjectAndTheHandApart) {
       }
       Frame f = render(scene, wMc, width);
       test::add_depth_noise(f.frame, 7u + static_cast<unsigned>(k));
-      const PerceptionResult r = perception.process(f.frame);
-      ASSERT_NE(r.status, TrackingStatus::Lost) << width << " frame " << k << ": " << r.message;
+      const perception::PerceptionResult r = perception.process(f.frame);
+      ASSERT_NE(r.status, perception::TrackingStatus::Lost) << width << " frame " << k << ": " << r.message;
       const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
       const auto score = test::score_object(r, truth, kObject);
       EXPECT_GE(score.precision, 0.95) << width << " frame " << k;
       EXPECT_GE(score.recall, 0.90) << width << " frame " << k;
-      EXPECT_EQ(test::count_truth_as(r, truth, kHand, SupervoxelClass::Object), 0)
+      EXPECT_EQ(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Object), 0)
           << width << " frame " << k;
       EXPECT_LE((r.centroid - test::truth_centroid(r, f.frame, f.labels, kObject)).norm(), 0.01)
           << width << " frame " << k;
@@ -283,15 +284,15 @@ TEST(Perception, NoisyDepthKeepsTheObjectAndTheHandApart) {
 }
 
 TEST(Perception, MovingCameraKeepsTheObjectFixedInTheWorld) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const test::SyntheticScene scene = test::table_and_case();
   for (int k = 0; k <= 10; ++k) {
     const double a = 0.05 * k;  // orbit 2.9 degrees per frame
     const Eigen::Vector3d eye =
         kCaseCentre + Eigen::Vector3d(0.45 * std::sin(a), -0.45 * std::cos(a), 0.22);
     const Frame f = render(scene, test::look_at(eye, kCaseCentre), 320);
-    const PerceptionResult r = perception.process(f.frame);
-    ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k << ": " << r.message;
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << r.message;
     const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
     EXPECT_GE(score.precision, 0.95) << "frame " << k;
     EXPECT_GE(score.recall, 0.90) << "frame " << k;
@@ -300,36 +301,36 @@ TEST(Perception, MovingCameraKeepsTheObjectFixedInTheWorld) {
 }
 
 TEST(Perception, ReportsALostObjectAndFindsItAgain) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
   ASSERT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
-            TrackingStatus::Initialised);
+            perception::TrackingStatus::Initialised);
   test::SyntheticScene empty = test::table_and_case();
   empty.shapes.pop_back();
-  const PerceptionResult gone = perception.process(render(empty, wMc).frame);
-  EXPECT_EQ(gone.status, TrackingStatus::Lost);
+  const perception::PerceptionResult gone = perception.process(render(empty, wMc).frame);
+  EXPECT_EQ(gone.status, perception::TrackingStatus::Lost);
   EXPECT_FALSE(gone.message.empty());
   EXPECT_EQ(gone.problem.positions.cols(), 0);
-  const PerceptionResult back = perception.process(render(test::table_and_case(), wMc).frame);
-  EXPECT_EQ(back.status, TrackingStatus::Tracking) << back.message;
+  const perception::PerceptionResult back = perception.process(render(test::table_and_case(), wMc).frame);
+  EXPECT_EQ(back.status, perception::TrackingStatus::Tracking) << back.message;
   EXPECT_LE((back.centroid - kFrontFace).norm(), 0.01);
 }
 
 TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
   ASSERT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
-            TrackingStatus::Initialised);
+            perception::TrackingStatus::Initialised);
   // A board hides the left half of the case for a few frames, then leaves.
   test::SyntheticScene hidden = test::table_and_case();
   hidden.shapes.push_back(
       test::make_box({-0.08, -0.2, 0.07}, {0.12, 0.01, 0.3}, {230, 230, 230}, test::kOther));
   for (int k = 0; k < 3; ++k) {
-    const PerceptionResult r = perception.process(render(hidden, wMc).frame);
-    ASSERT_EQ(r.status, TrackingStatus::Tracking) << r.message;
+    const perception::PerceptionResult r = perception.process(render(hidden, wMc).frame);
+    ASSERT_EQ(r.status, perception::TrackingStatus::Tracking) << r.message;
   }
   const Frame f = render(test::table_and_case(), wMc);
-  const PerceptionResult r = perception.process(f.frame);
+  const perception::PerceptionResult r = perception.process(f.frame);
   const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
   EXPECT_GE(score.recall, 0.90);
   EXPECT_GE(score.precision, 0.95);
@@ -337,7 +338,7 @@ TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
 
 /// Largest distance of the problem's hidden vertices (its last
 /// counts.hidden_vertices columns) from the case, the box of `centre` [m].
-double hidden_vertices_off_case(const PerceptionResult& r, const Eigen::Vector3d& centre) {
+double hidden_vertices_off_case(const perception::PerceptionResult& r, const Eigen::Vector3d& centre) {
   const auto n = static_cast<Eigen::Index>(r.counts.hidden_vertices);
   const Eigen::Index cols = r.problem.positions.cols();
   const Eigen::Vector3d half(0.095, 0.0075, 0.0675);
@@ -353,15 +354,15 @@ TEST(Perception, HiddenPartFollowsTheObjectsMotion) {
   // The case slides 3 mm per frame to the right behind a standing board that
   // hides its right part: after 15 frames (4.5 cm) the remembered hidden
   // vertices are on the case where it is now, not where they were last seen.
-  PerceptionSettings on;
+  perception::PerceptionSettings on;
   on.tracking.follow_motion = true;
-  PerceptionSettings off = on;
+  perception::PerceptionSettings off = on;
   off.tracking.follow_motion = false;
-  Perception follow{on};
-  Perception still{off};
+  perception::Perception follow{on};
+  perception::Perception still{off};
   const Eigen::Isometry3d wMc = test::front_camera();
-  PerceptionResult rf;
-  PerceptionResult rs;
+  perception::PerceptionResult rf;
+  perception::PerceptionResult rs;
   Eigen::Vector3d centre = kCaseCentre;
   for (int k = 0; k <= 15; ++k) {
     centre = kCaseCentre + Eigen::Vector3d(0.003 * k, 0.0, 0.0);
@@ -373,7 +374,7 @@ TEST(Perception, HiddenPartFollowsTheObjectsMotion) {
     const Frame f = render(scene, wMc);
     rf = follow.process(f.frame);
     rs = still.process(f.frame);
-    ASSERT_NE(rf.status, TrackingStatus::Lost) << "frame " << k << ": " << rf.message;
+    ASSERT_NE(rf.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rf.message;
   }
   ASSERT_GE(rf.counts.hidden_vertices, 3U);
   // Within 1 cm of the case where it is now (a supervoxel is 2 cm across),
@@ -389,12 +390,12 @@ TEST(Perception, HiddenPartOfAStaticObjectDoesNotDrift) {
   // The case stands still while a forearm passes slowly in front of it: the
   // motion estimated from the visible part is ~zero, so what is remembered
   // behind the arm stays where it was seen.
-  PerceptionSettings on;
+  perception::PerceptionSettings on;
   on.tracking.follow_motion = true;
-  PerceptionSettings off = on;
+  perception::PerceptionSettings off = on;
   off.tracking.follow_motion = false;
-  Perception follow{on};
-  Perception still{off};
+  perception::Perception follow{on};
+  perception::Perception still{off};
   const Eigen::Isometry3d wMc = test::front_camera();
   std::size_t most_hidden = 0;
   for (int k = 0; k <= 30; ++k) {
@@ -407,9 +408,9 @@ TEST(Perception, HiddenPartOfAStaticObjectDoesNotDrift) {
     }
     Frame f = render(scene, wMc, 320);
     test::add_depth_noise(f.frame, 11u + static_cast<unsigned>(k));
-    const PerceptionResult rf = follow.process(f.frame);
-    const PerceptionResult rs = still.process(f.frame);
-    ASSERT_NE(rf.status, TrackingStatus::Lost) << "frame " << k << ": " << rf.message;
+    const perception::PerceptionResult rf = follow.process(f.frame);
+    const perception::PerceptionResult rs = still.process(f.frame);
+    ASSERT_NE(rf.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rf.message;
     most_hidden = std::max(most_hidden, rf.counts.hidden_vertices);
     // C (with the remembered voxels) within 5 mm of C without following
     // (the estimated motion's noise, ~0.5 mm and 0.3 degrees a frame,
@@ -425,19 +426,19 @@ TEST(Perception, HiddenPartOfAStaticObjectDoesNotDrift) {
 // the case is presumed to go on behind it, in its plane, so the hidden part
 // is in the problem and is recognised as soon as it comes into view.
 TEST(Perception, AnObjectCutFromTheStartGoesOnBehindTheOccluder) {
-  PerceptionSettings on;
-  PerceptionSettings off = on;
+  perception::PerceptionSettings on;
+  perception::PerceptionSettings off = on;
   off.behind_occluders = false;
-  Perception presume{on};
-  Perception seen_only{off};
+  perception::Perception presume{on};
+  perception::Perception seen_only{off};
   const Eigen::Isometry3d wMc = test::front_camera();
   test::SyntheticScene cut = test::table_and_case();
   cut.shapes.push_back(test::make_box({-0.08, -0.2, 0.07}, {0.12, 0.01, 0.3}, {230, 230, 230}, test::kOther));
   const Frame f0 = render(cut, wMc);
-  const PerceptionResult r = presume.process(f0.frame);
-  const PerceptionResult r_off = seen_only.process(f0.frame);
-  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
-  ASSERT_EQ(r_off.status, TrackingStatus::Initialised) << r_off.message;
+  const perception::PerceptionResult r = presume.process(f0.frame);
+  const perception::PerceptionResult r_off = seen_only.process(f0.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
+  ASSERT_EQ(r_off.status, perception::TrackingStatus::Initialised) << r_off.message;
   EXPECT_EQ(r_off.counts.presumed_voxels, 0U);
   EXPECT_EQ(r_off.counts.hidden_vertices, 0U);
   ASSERT_GE(r.counts.hidden_vertices, 3U);
@@ -457,8 +458,8 @@ TEST(Perception, AnObjectCutFromTheStartGoesOnBehindTheOccluder) {
   // The board leaves: the whole case is object at once, and nothing of what
   // was presumed beyond it stays.
   const Frame f1 = render(test::table_and_case(), wMc);
-  const PerceptionResult r1 = presume.process(f1.frame);
-  const PerceptionResult r1_off = seen_only.process(f1.frame);
+  const perception::PerceptionResult r1 = presume.process(f1.frame);
+  const perception::PerceptionResult r1_off = seen_only.process(f1.frame);
   const auto score = test::score_object(r1, test::supervoxel_truth(r1, f1.frame, f1.labels), kObject);
   const auto score_off = test::score_object(r1_off, test::supervoxel_truth(r1_off, f1.frame, f1.labels), kObject);
   EXPECT_GE(score.recall, 0.9);
@@ -468,9 +469,9 @@ TEST(Perception, AnObjectCutFromTheStartGoesOnBehindTheOccluder) {
   EXPECT_EQ(r1.counts.presumed_voxels, 0U);
 
   // Nothing is presumed for an object the first frame sees whole.
-  Perception whole{on};
+  perception::Perception whole{on};
   EXPECT_EQ(whole.process(f1.frame).counts.presumed_voxels, 0U);
-  const PerceptionResult later = whole.process(f0.frame);
+  const perception::PerceptionResult later = whole.process(f0.frame);
   EXPECT_EQ(later.counts.presumed_voxels, 0U);
 
   // Nor for one seen through a cage: bars cut more of what is seen than
@@ -479,9 +480,9 @@ TEST(Perception, AnObjectCutFromTheStartGoesOnBehindTheOccluder) {
   for (const double x : {-0.05, 0.0, 0.05}) {
     caged.shapes.push_back(test::make_box({x, -0.2, 0.07}, {0.02, 0.01, 0.3}, {110, 110, 120}, test::kOther));
   }
-  Perception cage{on};
-  const PerceptionResult rc = cage.process(render(caged, wMc).frame);
-  ASSERT_EQ(rc.status, TrackingStatus::Initialised) << rc.message;
+  perception::Perception cage{on};
+  const perception::PerceptionResult rc = cage.process(render(caged, wMc).frame);
+  ASSERT_EQ(rc.status, perception::TrackingStatus::Initialised) << rc.message;
   EXPECT_EQ(rc.counts.presumed_voxels, 0U);
 }
 
@@ -492,12 +493,12 @@ TEST(Perception, BoxAndImageSelectionsPickTheCase) {
       test::make_box({0.3, 0.1, 0.05}, {0.1, 0.1, 0.1}, {200, 30, 30}, test::kOther));
   const Frame f = render(scene, wMc);
 
-  PerceptionSettings by_box;
-  by_box.selection.mode = ObjectSelection::Mode::Box;
+  perception::PerceptionSettings by_box;
+  by_box.selection.mode = perception::ObjectSelection::Mode::Box;
   by_box.selection.box =
       Eigen::AlignedBox3d(Eigen::Vector3d(-0.12, -0.03, 0.005), Eigen::Vector3d(0.12, 0.03, 0.16));
-  PerceptionSettings by_rect;
-  by_rect.selection.mode = ObjectSelection::Mode::Image;
+  perception::PerceptionSettings by_rect;
+  by_rect.selection.mode = perception::ObjectSelection::Mode::Image;
   // The case's front face, projected: pixels of the ground truth's bounding box.
   Eigen::AlignedBox2i rect;
   for (int v = 0; v < f.frame.intrinsics.height; ++v) {
@@ -508,26 +509,26 @@ TEST(Perception, BoxAndImageSelectionsPickTheCase) {
     }
   }
   by_rect.selection.rect = rect;
-  PerceptionSettings by_mask;
-  by_mask.selection.mode = ObjectSelection::Mode::Image;
+  perception::PerceptionSettings by_mask;
+  by_mask.selection.mode = perception::ObjectSelection::Mode::Image;
   by_mask.selection.mask.resize(f.labels.size());
   std::transform(f.labels.begin(), f.labels.end(), by_mask.selection.mask.begin(),
                  [](int l) { return l == kObject ? 1 : 0; });
 
-  for (const PerceptionSettings& s : {by_box, by_rect, by_mask}) {
-    Perception perception{s};
-    const PerceptionResult r = perception.process(f.frame);
-    ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  for (const perception::PerceptionSettings& s : {by_box, by_rect, by_mask}) {
+    perception::Perception perception{s};
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
     const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
     EXPECT_GE(score.precision, 0.95);
     EXPECT_GE(score.recall, 0.90);
   }
 
-  PerceptionSettings nowhere = by_box;
+  perception::PerceptionSettings nowhere = by_box;
   nowhere.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(3, 3, 3));
-  Perception lost{nowhere};
-  const PerceptionResult r = lost.process(f.frame);
-  EXPECT_EQ(r.status, TrackingStatus::Lost);
+  perception::Perception lost{nowhere};
+  const perception::PerceptionResult r = lost.process(f.frame);
+  EXPECT_EQ(r.status, perception::TrackingStatus::Lost);
   EXPECT_NE(r.message.find("box"), std::string::npos);
 }
 
@@ -542,12 +543,12 @@ TEST(Perception, ResultMovesWithARigidMotionOfTheWholeWorld) {
     s.pose = T * s.pose;
   }
   const Eigen::Isometry3d wMc = test::front_camera();
-  Perception a{PerceptionSettings{}};
-  Perception b{PerceptionSettings{}};
-  const PerceptionResult ra = a.process(render(scene, wMc, 320).frame);
-  const PerceptionResult rb = b.process(render(moved, T * wMc, 320).frame);
-  ASSERT_EQ(ra.status, TrackingStatus::Initialised);
-  ASSERT_EQ(rb.status, TrackingStatus::Initialised);
+  perception::Perception a{perception::PerceptionSettings{}};
+  perception::Perception b{perception::PerceptionSettings{}};
+  const perception::PerceptionResult ra = a.process(render(scene, wMc, 320).frame);
+  const perception::PerceptionResult rb = b.process(render(moved, T * wMc, 320).frame);
+  ASSERT_EQ(ra.status, perception::TrackingStatus::Initialised);
+  ASSERT_EQ(rb.status, perception::TrackingStatus::Initialised);
   // Voxel grids are axis-aligned, so agreement is up to about a voxel.
   EXPECT_LE((T * ra.centroid - rb.centroid).norm(), 0.005);
   EXPECT_GT(std::abs((T.linear() * ra.axes.col(0)).dot(rb.axes.col(0))), 0.98);
@@ -558,22 +559,22 @@ TEST(Perception, ResultMovesWithARigidMotionOfTheWholeWorld) {
 
 TEST(Perception, RejectsInvalidSettings) {
   const auto throws = [](auto mutate) {
-    PerceptionSettings s;
+    perception::PerceptionSettings s;
     mutate(s);
-    EXPECT_THROW(Perception{s}, std::invalid_argument);
+    EXPECT_THROW(perception::Perception{s}, std::invalid_argument);
   };
-  throws([](PerceptionSettings& s) { s.supervoxels.adjacency_alpha = 2.0; });
-  throws([](PerceptionSettings& s) { s.supervoxels.voxel_resolution = 0.0; });
-  throws([](PerceptionSettings& s) { s.supervoxels.seed_resolution = 0.001; });
-  throws([](PerceptionSettings& s) { s.r_sphere = -1.0; });
-  throws([](PerceptionSettings& s) { s.contact_distance = 0.0; });
-  throws([](PerceptionSettings& s) { s.tracking.min_near_fraction = 0.0; });
-  throws([](PerceptionSettings& s) { s.selection.mode = ObjectSelection::Mode::Box; });
-  throws([](PerceptionSettings& s) { s.selection.mode = ObjectSelection::Mode::Image; });
+  throws([](perception::PerceptionSettings& s) { s.supervoxels.adjacency_alpha = 2.0; });
+  throws([](perception::PerceptionSettings& s) { s.supervoxels.voxel_resolution = 0.0; });
+  throws([](perception::PerceptionSettings& s) { s.supervoxels.seed_resolution = 0.001; });
+  throws([](perception::PerceptionSettings& s) { s.r_sphere = -1.0; });
+  throws([](perception::PerceptionSettings& s) { s.contact_distance = 0.0; });
+  throws([](perception::PerceptionSettings& s) { s.tracking.min_near_fraction = 0.0; });
+  throws([](perception::PerceptionSettings& s) { s.selection.mode = perception::ObjectSelection::Mode::Box; });
+  throws([](perception::PerceptionSettings& s) { s.selection.mode = perception::ObjectSelection::Mode::Image; });
   try {
-    PerceptionSettings s;
+    perception::PerceptionSettings s;
     s.supervoxels.adjacency_alpha = 2.0;
-    Perception p{s};
+    perception::Perception p{s};
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("adjacency_alpha"), std::string::npos);
@@ -581,14 +582,26 @@ TEST(Perception, RejectsInvalidSettings) {
 }
 
 TEST(Perception, EmptyFrameIsLostNotACrash) {
-  Perception perception{PerceptionSettings{}};
+  perception::Perception perception{perception::PerceptionSettings{}};
   RgbdFrame f;
   f.intrinsics = test::vga(320);
   f.depth.assign(320 * 240, 0.0f);
-  const PerceptionResult r = perception.process(f);
-  EXPECT_EQ(r.status, TrackingStatus::Lost);
+  const perception::PerceptionResult r = perception.process(f);
+  EXPECT_EQ(r.status, perception::TrackingStatus::Lost);
   EXPECT_EQ(r.counts.supervoxels, 0u);
 }
+
+// The names of ofv 0.1 (before ofv::perception) stay for one release as
+// deprecated aliases.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+TEST(Namespaces, TheOldPerceptionNamesAreTheNewOnes) {
+  static_assert(std::is_same_v<ofv::Perception, perception::Perception>);
+  static_assert(std::is_same_v<ofv::PerceptionSettings, perception::PerceptionSettings>);
+  static_assert(std::is_same_v<ofv::PerceptionCounts, perception::PerceptionCounts>);
+  EXPECT_EQ(&ofv::perception_settings_table(), &perception::perception_settings_table());
+}
+#pragma GCC diagnostic pop
 
 }  // namespace
 }  // namespace ofv

@@ -37,9 +37,9 @@ int count_outside_inset(const cv::Mat& image, const Eigen::Vector3i& colour) {
 
 TEST(PerceptionPicture, ShowsTheObjectAndInsetsTheCameraImage) {
   const RgbdFrame frame = test::table_and_case().render(test::vga(320), test::front_camera());
-  Perception perception{PerceptionSettings{}};
-  const PerceptionResult r = perception.process(frame);
-  ASSERT_EQ(r.status, TrackingStatus::Initialised) << r.message;
+  perception::Perception perception{perception::PerceptionSettings{}};
+  const perception::PerceptionResult r = perception.process(frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
   const ViewEstimate e = estimate_view(r.problem, EstimatorSettings{});
   const std::string path = test::scratch_dir() + "ofv_picture.png";
   save_perception_picture(path, frame, r, e, 0.5);
@@ -66,7 +66,7 @@ TEST(PerceptionPicture, ShowsTheObjectAndInsetsTheCameraImage) {
 
 TEST(PerceptionPicture, LostObjectStillGivesAPicture) {
   const RgbdFrame frame = test::table_and_case().render(test::vga(160), test::front_camera());
-  PerceptionResult lost;
+  perception::PerceptionResult lost;
   lost.message = "no supervoxel near the object's last state";
   const std::string path = test::scratch_dir() + "ofv_picture_lost.png";
   save_perception_picture(path, frame, lost, std::nullopt, 0.5);
@@ -79,7 +79,7 @@ TEST(PerceptionPicture, UnwritablePathIsAnErrorNamingIt) {
   const RgbdFrame frame = test::table_and_case().render(test::vga(160), test::front_camera());
   const std::string path = test::scratch_dir() + "no/such/folder/picture.png";
   try {
-    save_perception_picture(path, frame, PerceptionResult{}, std::nullopt, 0.5);
+    save_perception_picture(path, frame, perception::PerceptionResult{}, std::nullopt, 0.5);
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();

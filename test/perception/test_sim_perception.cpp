@@ -37,8 +37,8 @@ struct EpisodeStats {
 EpisodeStats run_scenario(const std::string& name, double until) {
   const sim::Scenario scenario = sim::load_scenario(name);
   sim::Renderer renderer(scenario);
-  PerceptionSettings settings;
-  Perception perception(settings);
+  perception::PerceptionSettings settings;
+  perception::Perception perception(settings);
   EpisodeStats s;
   const int frames = static_cast<int>(std::min(until, scenario.duration) * scenario.rate);
   for (int k = 0; k < frames; ++k) {
@@ -46,9 +46,9 @@ EpisodeStats run_scenario(const std::string& name, double until) {
     const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
     const RgbdFrame& frame = rendered.frame;
     const std::vector<int> labels(rendered.frame.labels.begin(), rendered.frame.labels.end());
-    const PerceptionResult r = perception.process(frame);
+    const perception::PerceptionResult r = perception.process(frame);
     ++s.frames;
-    if (r.status == TrackingStatus::Lost) {
+    if (r.status == perception::TrackingStatus::Lost) {
       ++s.lost;
       continue;
     }
@@ -80,16 +80,16 @@ EpisodeStats run_scenario(const std::string& name, double until) {
     for (const int label : occluders_in_sphere) {
       ++s.frames_with_occluder_in_sphere;
       s.frames_occluder_found +=
-          test::count_truth_as(r, truth, label, SupervoxelClass::Occluder) > 0 ? 1 : 0;
+          test::count_truth_as(r, truth, label, perception::SupervoxelClass::Occluder) > 0 ? 1 : 0;
     }
     if (std::count(truth.begin(), truth.end(), sim::kLabelInteracting) > 0) {
       ++s.frames_holder_visible;
       s.frames_holder_interacting +=
-          test::count_truth_as(r, truth, sim::kLabelInteracting, SupervoxelClass::Interacting) > 0
+          test::count_truth_as(r, truth, sim::kLabelInteracting, perception::SupervoxelClass::Interacting) > 0
               ? 1
               : 0;
       s.holder_as_object +=
-          test::count_truth_as(r, truth, sim::kLabelInteracting, SupervoxelClass::Object);
+          test::count_truth_as(r, truth, sim::kLabelInteracting, perception::SupervoxelClass::Object);
     }
   }
   return s;
@@ -158,23 +158,23 @@ TEST(SimPerception, MovingObject) {
 TEST(SimPerception, HiddenObjectSupervoxelsStayInTheProblem) {
   const sim::Scenario scenario = sim::load_scenario("dvd-one-hand");
   sim::Renderer renderer(scenario);
-  PerceptionSettings with;
-  PerceptionSettings without;
+  perception::PerceptionSettings with;
+  perception::PerceptionSettings without;
   without.tracking.hidden_vertices = false;
-  Perception a(with), b(without);
+  perception::Perception a(with), b(without);
   const Eigen::Isometry3d cMw = scenario.wMc_start.inverse();
   std::size_t most_hidden = 0;
   for (int k = 0; k < static_cast<int>(2.3 * scenario.rate); ++k) {
     renderer.set_time(k / scenario.rate);
     const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
-    const PerceptionResult ra = a.process(rendered.frame);
-    const PerceptionResult rb = b.process(rendered.frame);
-    ASSERT_NE(ra.status, TrackingStatus::Lost);
-    ASSERT_NE(rb.status, TrackingStatus::Lost);
+    const perception::PerceptionResult ra = a.process(rendered.frame);
+    const perception::PerceptionResult rb = b.process(rendered.frame);
+    ASSERT_NE(ra.status, perception::TrackingStatus::Lost);
+    ASSERT_NE(rb.status, perception::TrackingStatus::Lost);
     EXPECT_EQ(rb.counts.hidden_vertices, 0U);
     const auto seen = static_cast<std::size_t>(std::count_if(
         rb.supervoxels.begin(), rb.supervoxels.end(),
-        [](const SupervoxelInfo& s) { return s.label == SupervoxelClass::Object && s.normal_valid; }));
+        [](const perception::SupervoxelInfo& s) { return s.label == perception::SupervoxelClass::Object && s.normal_valid; }));
     EXPECT_EQ(static_cast<std::size_t>(rb.problem.positions.cols()), seen);
     const auto n = static_cast<Eigen::Index>(ra.counts.hidden_vertices);
     ASSERT_EQ(ra.problem.normals.cols(), ra.problem.positions.cols());
@@ -237,22 +237,22 @@ namespace {
 TEST(SimPerception, LabelsModeIsAPerfectClassifierOfTheFrame) {
   const sim::Scenario scenario = sim::load_scenario("dvd-one-hand");
   sim::Renderer renderer(scenario);
-  PerceptionSettings settings;
-  settings.classes = PerceptionSettings::Classes::Labels;
-  Perception perception(settings);
+  perception::PerceptionSettings settings;
+  settings.classes = perception::PerceptionSettings::Classes::Labels;
+  perception::Perception perception(settings);
   int occluded_frames = 0;
   for (int k = 0; k < static_cast<int>(2.5 * scenario.rate); ++k) {
     renderer.set_time(k / scenario.rate);
     const sim::RenderedFrame rendered = renderer.render(scenario.wMc_start, k);
-    const PerceptionResult r = perception.process(rendered.frame);
-    ASSERT_NE(r.status, TrackingStatus::Lost) << "frame " << k;
-    PerceptionTruth truth;
+    const perception::PerceptionResult r = perception.process(rendered.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "frame " << k;
+    perception::PerceptionTruth truth;
     truth.centroid = rendered.frame.object_centroid;
     ASSERT_TRUE(truth.centroid);
     EXPECT_LT((*truth.centroid - renderer.truth(scenario.wMc_start, settings.r_sphere).centroid).norm(), 1e-12);
     truth.r_sphere = settings.r_sphere;
     truth.surface = renderer.object_surface();
-    const PerceptionScores s = score_perception(rendered.frame, r, truth, settings);
+    const perception::PerceptionScores s = score_perception(rendered.frame, r, truth, settings);
     EXPECT_DOUBLE_EQ(*s.object_precision, 1.0) << "frame " << k;
     EXPECT_GE(*s.object_recall, 0.98) << "frame " << k;
     if (s.occluder_precision) {
@@ -263,8 +263,8 @@ TEST(SimPerception, LabelsModeIsAPerfectClassifierOfTheFrame) {
       EXPECT_GE(*s.occluder_recall, 0.95) << "frame " << k;
     }
     // The holder is never an occluder, the support only by the paper's rule.
-    for (const SupervoxelInfo& sv : r.supervoxels) {
-      if (sv.label == SupervoxelClass::Occluder) {
+    for (const perception::SupervoxelInfo& sv : r.supervoxels) {
+      if (sv.label == perception::SupervoxelClass::Occluder) {
         EXPECT_LT((sv.centroid - r.centroid).norm(), settings.r_sphere);
       }
     }
@@ -277,7 +277,7 @@ TEST(SimPerception, LabelsModeIsAPerfectClassifierOfTheFrame) {
   renderer.set_time(0.0);
   sim::RenderedFrame unlabelled = renderer.render(scenario.wMc_start, 0);
   unlabelled.frame.labels.clear();
-  Perception fresh(settings);
+  perception::Perception fresh(settings);
   EXPECT_THROW((void)fresh.process(unlabelled.frame), std::invalid_argument);
 }
 

@@ -290,15 +290,15 @@ TEST(TumSequence, PerceptionOnARecordingMatchesTheLiveFrames) {
       writer.write(f);
     }
   }
-  Perception live{PerceptionSettings{}};
-  Perception replay{PerceptionSettings{}};
+  perception::Perception live{perception::PerceptionSettings{}};
+  perception::Perception replay{perception::PerceptionSettings{}};
   TumSequenceSource source(dir.string());
   for (const RgbdFrame& f : frames) {
     const auto read = source.next();
     ASSERT_TRUE(read);
-    const PerceptionResult a = live.process(f);
-    const PerceptionResult b = replay.process(*read);
-    ASSERT_NE(a.status, TrackingStatus::Lost);
+    const perception::PerceptionResult a = live.process(f);
+    const perception::PerceptionResult b = replay.process(*read);
+    ASSERT_NE(a.status, perception::TrackingStatus::Lost);
     ASSERT_EQ(a.status, b.status);
     // 0.2 mm depth quantisation can flip a boundary supervoxel, nothing more:
     // the centroids agree within the front end's 1 cm accuracy.

@@ -5,6 +5,7 @@
 #include "ofv/servo/robot.h"
 #include "ofv/servo/safety.h"
 #include "ofv/servo/target_pose.h"
+#include "ofv/servo/view_loop.h"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 
 #include <chrono>
 #include <random>
+#include <type_traits>
 
 namespace ofv {
 namespace {
@@ -50,7 +52,7 @@ TEST(TargetPose, LooksAtTheCentroidWithTheLeastRotation) {
 // s after the camera moves by twist v for a time h.
 vpColVector feature_after(const vpHomogeneousMatrix& wMc, const vpColVector& c, const vpColVector& t,
                           const vpColVector& v, double h) {
-  FeatureSphereView s;
+  servo::FeatureSphereView s;
   s.build((wMc * vpExponentialMap::direct(v, h)).inverse(), c, t, 0.5);
   return s.get_s();
 }
@@ -63,7 +65,7 @@ TEST(FeatureSphereView, InteractionMatrixMatchesFiniteDifferences) {
     const vpColVector t{u(rng), u(rng), u(rng)};
     const vpHomogeneousMatrix wMc = looking_at({0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng)},
                                                {c[0] + 0.05 * u(rng), c[1], c[2]});
-    FeatureSphereView s;
+    servo::FeatureSphereView s;
     s.build(wMc.inverse(), c, t, 0.5);
     const vpMatrix L = s.interaction();
     ASSERT_EQ(L.getRows(), 6U);
@@ -77,23 +79,23 @@ TEST(FeatureSphereView, InteractionMatrixMatchesFiniteDifferences) {
     }
   }
   // Selection keeps the chosen rows.
-  FeatureSphereView s;
+  servo::FeatureSphereView s;
   const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, {0, 0, 0.5});
   s.build(wMc.inverse(), vpColVector{0.0, 0.0, 0.5}, vpColVector{0.5, 0.0, 0.5}, 0.5);
-  EXPECT_EQ(s.interaction(FeatureSphereView::selectRho() | FeatureSphereView::selectX()).getRows(), 2U);
+  EXPECT_EQ(s.interaction(servo::FeatureSphereView::selectRho() | servo::FeatureSphereView::selectX()).getRows(), 2U);
   EXPECT_THROW(s.build(wMc.inverse(), vpColVector{0.0, 0.0, -0.5}, vpColVector{1.0, 0.0, 0.0}, 0.5),
                std::invalid_argument);
 }
 
 // Servo a free-flying camera from a view on the sphere towards a target view
 // 90 degrees away; returns the largest |distance to C - R| and the smallest distance.
-std::pair<double, double> servo_to(ControllerSettings::Law law, double* final_error = nullptr) {
+std::pair<double, double> servo_to(servo::ControllerSettings::Law law, double* final_error = nullptr) {
   const Eigen::Vector3d c(0, 0, 0.5), tf(0.5, 0, 0.5);
   const double r = 0.5;
-  ControllerSettings settings;
+  servo::ControllerSettings settings;
   settings.law = law;
-  ViewController controller(settings);
-  FreeFlyingCamera camera(looking_at({0, 0, 0}, c));
+  servo::ViewController controller(settings);
+  servo::FreeFlyingCamera camera(looking_at({0, 0, 0}, c));
   double worst = 0.0, nearest = 1e9;
   for (int k = 0; k < 150; ++k) {
     const vpColVector v = controller.update(tf, c, r, camera.wMc(), 1.0 / 30);
@@ -108,8 +110,8 @@ std::pair<double, double> servo_to(ControllerSettings::Law law, double* final_er
 
 TEST(ViewController, TheSphereLawTravelsAlongTheSphereWhilePbvsCutsTheChord) {
   double err_sphere = 0.0, err_pbvs = 0.0;
-  const auto sphere = servo_to(ControllerSettings::Law::Sphere, &err_sphere);
-  const auto pbvs = servo_to(ControllerSettings::Law::Pbvs, &err_pbvs);
+  const auto sphere = servo_to(servo::ControllerSettings::Law::Sphere, &err_sphere);
+  const auto pbvs = servo_to(servo::ControllerSettings::Law::Pbvs, &err_pbvs);
   EXPECT_LT(sphere.first, 0.02);
   EXPECT_LT(pbvs.second, 0.5 - 0.1);  // the chord passes ~0.35 m from C
   EXPECT_LT(err_sphere, 0.005);       // both arrive
@@ -117,9 +119,9 @@ TEST(ViewController, TheSphereLawTravelsAlongTheSphereWhilePbvsCutsTheChord) {
 }
 
 TEST(ViewController, CommandsAreBoundedAndFinite) {
-  ControllerSettings s;
+  servo::ControllerSettings s;
   s.gain = 1000.0;
-  ViewController controller(s);
+  servo::ViewController controller(s);
   const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, {0, 0, 0.5});
   const vpColVector v = controller.update({0.5, 0, 0.5}, {0, 0, 0.5}, 0.5, wMc, 1.0 / 30);
   EXPECT_LE(std::hypot(v[0], v[1], v[2]), s.max_linear_speed + 1e-12);
@@ -127,21 +129,21 @@ TEST(ViewController, CommandsAreBoundedAndFinite) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(controller.update({nan, 0, 0}, {0, 0, 0.5}, 0.5, wMc, 0.03).frobeniusNorm(), 0.0);
   EXPECT_EQ(controller.update({0, 0, 0.5}, {0, 0, 0.5}, 0.5, wMc, 0.03).frobeniusNorm(), 0.0);
-  ControllerSettings bad;
+  servo::ControllerSettings bad;
   bad.max_linear_speed = -1;
-  EXPECT_THROW(ViewController{bad}, std::invalid_argument);
+  EXPECT_THROW(servo::ViewController{bad}, std::invalid_argument);
 }
 
 TEST(Robots, FollowAConstantTwist) {
   const vpHomogeneousMatrix start = looking_at({0, 0, 0}, {0, 0, 0.5});
   const vpColVector v{0.05, -0.02, 0.03, 0.1, -0.05, 0.08};
-  for (const RobotKind kind : {RobotKind::Camera, RobotKind::Viper850, RobotKind::Afma6}) {
+  for (const servo::RobotKind kind : {servo::RobotKind::Camera, servo::RobotKind::Viper850, servo::RobotKind::Afma6}) {
     const std::string name = to_string(kind);
     EXPECT_EQ(parse_robot_kind(name), kind);
     auto robot = make_robot(kind, start);
     EXPECT_TRUE(to_eigen(robot->wMc()).isApprox(to_eigen(start), 1e-9)) << name;
     const double dt = 0.01;
-    const RobotStep step = robot->step(v, dt);
+    const servo::RobotStep step = robot->step(v, dt);
     const Eigen::Isometry3d expected = to_eigen(start * vpExponentialMap::direct(v, dt));
     EXPECT_LT((to_eigen(step.wMc).translation() - expected.translation()).norm(), 1e-5) << name;
     EXPECT_LT(Eigen::AngleAxisd(to_eigen(step.wMc).linear().transpose() * expected.linear()).angle(), 1e-4) << name;
@@ -155,9 +157,9 @@ TEST(Robots, FollowAConstantTwist) {
 // twist, so that reading the pose in the wrong rotation convention would show.
 TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
   const vpHomogeneousMatrix start = looking_at({0.1, -0.05, 0}, {0, 0, 0.5});
-  for (const auto model : {KinematicArm::Model::Viper850, KinematicArm::Model::Afma6}) {
-    ThreadedArm threaded(model, start);
-    KinematicArm twin(model, start);
+  for (const auto model : {servo::KinematicArm::Model::Viper850, servo::KinematicArm::Model::Afma6}) {
+    servo::ThreadedArm threaded(model, start);
+    servo::KinematicArm twin(model, start);
     EXPECT_TRUE(to_eigen(threaded.wMc()).isApprox(to_eigen(start), 1e-6)) << threaded.name();
     const vpColVector v{0.04, 0.0, 0.02, 0.0, 0.3, 0.15};
     const double dt = 1.0 / 30.0;
@@ -174,7 +176,7 @@ TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
     EXPECT_GT(Eigen::AngleAxisd(to_eigen(start).linear().transpose() * b.linear()).angle(), 5.0 * kPi / 180.0)
         << "the twin should have turned";
   }
-  EXPECT_THROW((void)make_robot(RobotKind::Camera, start, /*real_time=*/true), std::invalid_argument);
+  EXPECT_THROW((void)make_robot(servo::RobotKind::Camera, start, /*real_time=*/true), std::invalid_argument);
 }
 
 // Driven into a joint limit and then held still, the threaded arm stops
@@ -185,17 +187,17 @@ TEST(Robots, ThreadedArmStopsShortOfItsJointLimits) {
   const double dt = 1.0 / 30.0;
   // Twists that bring the wrist (joint 5) onto its limit within a second,
   // sent for 40 frames.
-  for (const auto& [model, v] : {std::pair{KinematicArm::Model::Viper850, vpColVector{0, 0, -0.3, 0, 0, 0}},
-                                 std::pair{KinematicArm::Model::Afma6, vpColVector{0, 0, 0, -1.0, 0, 0}}}) {
-    ThreadedArm arm(model, start);
+  for (const auto& [model, v] : {std::pair{servo::KinematicArm::Model::Viper850, vpColVector{0, 0, -0.3, 0, 0, 0}},
+                                 std::pair{servo::KinematicArm::Model::Afma6, vpColVector{0, 0, 0, -1.0, 0, 0}}}) {
+    servo::ThreadedArm arm(model, start);
     const vpColVector lo = arm.joint_min(), hi = arm.joint_max();
     for (int k = 0; k < 45; ++k) {
       (void)arm.step(k < 40 ? v : vpColVector(6, 0.0), dt);
       const vpColVector q = arm.joints();
       for (unsigned i = 0; i < 6; ++i) {
         ASSERT_TRUE(std::isfinite(q[i])) << arm.name() << " step " << k;
-        EXPECT_GE(q[i] - lo[i], 0.5 * ThreadedArm::kJointLimitMargin) << arm.name() << " joint " << i << " step " << k;
-        EXPECT_GE(hi[i] - q[i], 0.5 * ThreadedArm::kJointLimitMargin) << arm.name() << " joint " << i << " step " << k;
+        EXPECT_GE(q[i] - lo[i], 0.5 * servo::ThreadedArm::kJointLimitMargin) << arm.name() << " joint " << i << " step " << k;
+        EXPECT_GE(hi[i] - q[i], 0.5 * servo::ThreadedArm::kJointLimitMargin) << arm.name() << " joint " << i << " step " << k;
       }
     }
     const vpColVector q = arm.joints();
@@ -207,7 +209,7 @@ TEST(Robots, ThreadedArmStopsShortOfItsJointLimits) {
 }
 
 TEST(Robots, JointLimitsClamp) {
-  KinematicArm arm(KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
+  servo::KinematicArm arm(servo::KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
   bool limited = false;
   for (int k = 0; k < 400 && !limited; ++k) limited = arm.step(vpColVector{0, 0, 0, 0, 0, 1.0}, 0.05).limited;
   EXPECT_TRUE(limited);
@@ -222,8 +224,8 @@ TEST(Robots, JointLimitsClamp) {
 // for unbounded joint speeds; the arm must neither jump nor exceed the
 // commanded camera speed.
 TEST(Robots, ArmsStayBoundedAtASingularity) {
-  KinematicArm arm(KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
-  vpColVector q = KinematicArm::start_joints(KinematicArm::Model::Viper850);
+  servo::KinematicArm arm(servo::KinematicArm::Model::Viper850, looking_at({0, 0, 0}, {0, 0, 0.5}));
+  vpColVector q = servo::KinematicArm::start_joints(servo::KinematicArm::Model::Viper850);
   q[4] = 1e-4;
   arm.set_joints(q);
   const vpColVector v{0.3, 0.2, 0.0, 0.5, 0.4, 0.0};
@@ -243,7 +245,7 @@ TEST(Robots, ArmsStayBoundedAtASingularity) {
 TEST(Robots, ADriverPoseThatIsNotFiniteIsAnError) {
   vpSimulatorCamera driver;
   bool faulty = false;
-  VispRobot robot(
+  servo::VispRobot robot(
       driver,
       [&faulty] {
         vpHomogeneousMatrix fMc;
@@ -264,41 +266,55 @@ TEST(Robots, ADriverPoseThatIsNotFiniteIsAnError) {
 }
 
 TEST(Safety, EachRule) {
-  SafetySettings s;
+  servo::SafetySettings s;
   s.workspace = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 0.05));
   const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, {0, 0, 0.5});
   const vpColVector fast{1.0, 0, 0, 0, 0, 0};
   {
-    SafetyFilter f(s);
+    servo::SafetyFilter f(s);
     EXPECT_EQ(f.filter(fast, wMc, 0.03, false, 0.0).frobeniusNorm(), 0.0);
-    EXPECT_EQ(f.last_action(), SafetyAction::ObjectLost);
+    EXPECT_EQ(f.last_action(), servo::SafetyAction::ObjectLost);
     EXPECT_EQ(f.filter(fast, wMc, 0.03, true, 1.0).frobeniusNorm(), 0.0);
-    EXPECT_EQ(f.last_action(), SafetyAction::StaleFrame);
+    EXPECT_EQ(f.last_action(), servo::SafetyAction::StaleFrame);
   }
   {
-    SafetyFilter f(s);  // from rest, the acceleration limit binds first
+    servo::SafetyFilter f(s);  // from rest, the acceleration limit binds first
     const vpColVector v = f.filter(fast, wMc, 0.03, true, 0.0);
     EXPECT_NEAR(v[0], s.max_linear_accel * 0.03, 1e-12);
     for (int k = 0; k < 100; ++k) (void)f.filter(fast, wMc, 0.03, true, 0.0);
     EXPECT_NEAR(f.filter(fast, wMc, 0.03, true, 0.0)[0], s.max_linear_speed, 1e-12);
   }
   {
-    SafetyFilter f(s);  // forward (+z world) would leave the box at z = 0.05
+    servo::SafetyFilter f(s);  // forward (+z world) would leave the box at z = 0.05
     vpHomogeneousMatrix at_edge = wMc;
     at_edge[2][3] = 0.05;
     vpColVector forward(6, 0.0);
     forward[2] = 0.01;
     EXPECT_EQ(f.filter(forward, at_edge, 0.03, true, 0.0)[2], 0.0);
-    EXPECT_EQ(f.last_action(), SafetyAction::WorkspaceBound);
+    EXPECT_EQ(f.last_action(), servo::SafetyAction::WorkspaceBound);
   }
-  SafetyFilter f(s);
+  servo::SafetyFilter f(s);
   EXPECT_EQ(f.filter(vpColVector{std::nan(""), 0, 0, 0, 0, 0}, wMc, 0.03, true, 0.0).frobeniusNorm(), 0.0);
-  EXPECT_EQ(f.last_action(), SafetyAction::InvalidCommand);
+  EXPECT_EQ(f.last_action(), servo::SafetyAction::InvalidCommand);
   EXPECT_TRUE(stops(f.last_action()));
-  SafetySettings bad;
+  servo::SafetySettings bad;
   bad.max_linear_accel = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(SafetyFilter{bad}, std::invalid_argument);
+  EXPECT_THROW(servo::SafetyFilter{bad}, std::invalid_argument);
 }
+
+// The names of ofv 0.1 (before ofv::servo) stay for one release as
+// deprecated aliases of the same types and functions.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+TEST(Namespaces, TheOldServoNamesAreTheNewOnes) {
+  static_assert(std::is_same_v<ofv::ViewLoop, servo::ViewLoop>);
+  static_assert(std::is_same_v<ofv::LoopSettings, servo::LoopSettings>);
+  static_assert(std::is_same_v<ofv::CameraRobot, servo::CameraRobot>);
+  static_assert(std::is_same_v<ofv::SafetyAction, servo::SafetyAction>);
+  EXPECT_EQ(&ofv::loop_transitions(), &servo::loop_transitions());
+  EXPECT_STREQ(ofv::to_string(ofv::RobotKind::Afma6), servo::to_string(servo::RobotKind::Afma6));
+}
+#pragma GCC diagnostic pop
 
 }  // namespace
 }  // namespace ofv

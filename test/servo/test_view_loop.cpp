@@ -58,52 +58,52 @@ class Fixed : public Observer {
 double speed(const vpColVector& v) { return std::hypot(v[0], v[1], v[2]); }
 
 TEST(ViewLoop, StatusesAndTheSafetyFilterInTheLoop) {
-  LoopSettings settings;
-  ViewLoop loop(settings);
+  servo::LoopSettings settings;
+  servo::ViewLoop loop(settings);
   const vpHomogeneousMatrix wMc;  // at the origin, looking along +z at the patch
   const double dt = 1.0 / 30.0;
-  LoopStep s = loop.step(observed(patch(false), wMc, 0.0), dt);
-  EXPECT_EQ(s.status, StepStatus::NoOccluders);
+  servo::LoopStep s = loop.step(observed(patch(false), wMc, 0.0), dt);
+  EXPECT_EQ(s.status, servo::StepStatus::NoOccluders);
   ASSERT_TRUE(s.target);
   s = loop.step(observed(patch(true), wMc, 0.0), dt);
-  EXPECT_EQ(s.status, StepStatus::Converged);
+  EXPECT_EQ(s.status, servo::StepStatus::Converged);
   EXPECT_GT(s.estimate->iterations, 0);
   // From rest the command is cut to what the acceleration limit allows.
   EXPECT_GT(speed(s.command), settings.safety.max_linear_accel * dt);
-  EXPECT_EQ(s.safety, SafetyAction::AccelerationLimit);
+  EXPECT_EQ(s.safety, servo::SafetyAction::AccelerationLimit);
   EXPECT_LE(speed(s.velocity), 2.0 * settings.safety.max_linear_accel * dt + 1e-12);
   // A lost object or a stale frame stops the robot at once.
   s = loop.step(observed(std::nullopt, wMc, 0.0), dt);
-  EXPECT_EQ(s.status, StepStatus::ObjectLost);
-  EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
+  EXPECT_EQ(s.status, servo::StepStatus::ObjectLost);
+  EXPECT_EQ(s.safety, servo::SafetyAction::ObjectLost);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
   s = loop.step(observed(patch(true), wMc, 5.0), dt);
-  EXPECT_EQ(s.safety, SafetyAction::StaleFrame);
+  EXPECT_EQ(s.safety, servo::SafetyAction::StaleFrame);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
   // No usable supervoxel is a lost object, not an exception.
   ViewProblem broken = patch(true);
   broken.normals.setZero();
-  EXPECT_EQ(loop.step(observed(broken, wMc, 0.0), dt).status, StepStatus::ObjectLost);
+  EXPECT_EQ(loop.step(observed(broken, wMc, 0.0), dt).status, servo::StepStatus::ObjectLost);
   // The static baseline never moves.
   settings.method = ViewMethod::Static;
-  ViewLoop still(settings);
+  servo::ViewLoop still(settings);
   EXPECT_EQ(still.step(observed(patch(true), wMc, 0.0), dt).velocity.frobeniusNorm(), 0.0);
 }
 
 // The first frame whose target is more than 1 cm from t0 (the origin), as an
 // occluder cluster at 30 cm from the camera crosses the line of sight at
 // 0.6 m/s; -1 if none.
-int first_move(Anticipation anticipation) {
-  LoopSettings settings;
+int first_move(servo::Anticipation anticipation) {
+  servo::LoopSettings settings;
   settings.anticipation.mode = anticipation;
-  ViewLoop loop(settings);
+  servo::ViewLoop loop(settings);
   const vpHomogeneousMatrix wMc;  // the camera stays at the origin: only the target matters
   const double dt = 1.0 / 30.0;
   for (int k = 0; k < 30; ++k) {
     ViewProblem p = patch(false);
     p.occluders.resize(3, 9);
     for (int i = 0; i < 9; ++i) p.occluders.col(i) << -0.35 + 0.6 * k * dt + (i % 3) * 0.01, (i / 3 - 1) * 0.01, 0.3;
-    const LoopStep s = loop.step(observed(p, wMc, 0.0), dt);
+    const servo::LoopStep s = loop.step(observed(p, wMc, 0.0), dt);
     if (s.target && s.target->norm() > 0.01) return k;
   }
   return -1;
@@ -113,8 +113,8 @@ TEST(ViewLoop, AnticipationLeavesBeforeTheOccluderArrives) {
   // Reactive: the view moves once occlusion rays reach t0, when the cluster
   // is about 3 cm from the line of sight (frame 16). Predicting 0.8 s ahead,
   // it moves as soon as the track is confirmed and its path crosses t0.
-  const int reactive = first_move(Anticipation::Off);
-  const int ahead = first_move(Anticipation::Predict);
+  const int reactive = first_move(servo::Anticipation::Off);
+  const int ahead = first_move(servo::Anticipation::Predict);
   ASSERT_GE(reactive, 0);
   ASSERT_GE(ahead, 0);
   EXPECT_GE(reactive, 14);
@@ -143,22 +143,22 @@ ViewProblem occluded_patch(double side = 1.0) {
 }
 
 // `frames` frames at the origin showing 100; returns the last target.
-Eigen::Vector3d stay(ViewLoop& loop, int frames, double side = 1.0) {
-  LoopStep s;
+Eigen::Vector3d stay(servo::ViewLoop& loop, int frames, double side = 1.0) {
+  servo::LoopStep s;
   for (int k = 0; k < frames; ++k) s = loop.step(observed(occluded_patch(side), vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);
   EXPECT_TRUE(s.target);
   return s.target.value_or(Eigen::Vector3d::Constant(NAN));
 }
 
 // A frame at the origin with nothing in front of the patch: t0 is clear.
-void see_t0_clear(ViewLoop& loop) { (void)loop.step(observed(patch(false), vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0); }
+void see_t0_clear(servo::ViewLoop& loop) { (void)loop.step(observed(patch(false), vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0); }
 
 // Three frames on the way to `away` showing `shown_on_way` (of 100 at the
 // origin); returns the last target.
-Eigen::Vector3d leave(ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, double shown_on_way, double side = 1.0) {
+Eigen::Vector3d leave(servo::ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, double shown_on_way, double side = 1.0) {
   const Eigen::Vector3d object(0, 0, 0.5);
   const ViewProblem start = occluded_patch(side);
-  LoopStep s;
+  servo::LoopStep s;
   for (int k = 1; k <= 3; ++k) {
     const Eigen::Vector3d camera = away * 0.3 * k;  // on its way
     Eigen::Vector3d cluster = 0.5 * (camera + object);
@@ -177,9 +177,9 @@ Eigen::Vector3d leave(ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, do
 // `settle` frames at the origin, then three on the way to the estimator's
 // view; returns the last target.
 Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, double shown_on_way = 50.0) {
-  LoopSettings settings;
+  servo::LoopSettings settings;
   settings.retreat.drop = retreat_drop;
-  ViewLoop loop(settings);
+  servo::ViewLoop loop(settings);
   const Eigen::Vector3d away = stay(loop, settle);
   EXPECT_GT(away.norm(), 0.05);
   return leave(loop, away, loss, shown_on_way);
@@ -210,7 +210,7 @@ vpHomogeneousMatrix at(const Eigen::Vector3d& p) { return vpHomogeneousMatrix(vp
 // into view when the camera leaves, `way` before where it stops.
 int retreats_after_an_arrival(bool seen_before = true, double way = 0.1) {
   const double dt = 1.0 / 30.0;
-  ViewLoop loop(LoopSettings{});
+  servo::ViewLoop loop(servo::LoopSettings{});
   const auto frame = [&](const Eigen::Vector3d& camera, const std::optional<Eigen::Vector3d>& cluster, double shown) {
     ViewProblem p = occluded_patch();
     if (cluster) {
@@ -235,7 +235,7 @@ int retreats_after_an_arrival(bool seen_before = true, double way = 0.1) {
     const Eigen::Vector3d to_stop = stop - cluster;
     const bool moving = to_stop.norm() > 1e-9;
     cluster += to_stop.norm() <= 0.02 ? to_stop : (0.02 * to_stop.normalized()).eval();
-    const LoopStep s = frame(camera, cluster, 40.0);
+    const servo::LoopStep s = frame(camera, cluster, 40.0);
     if (!moving && s.target && s.target->norm() < 1e-9) ++back;
   }
   return back;
@@ -260,52 +260,52 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   // safety filter lets this motion through), and stops there.
   const double dt = 1.0 / 30.0;
   const Eigen::Vector3d away(0.06, 0.0, 0.0);
-  LoopSettings settings;
-  ViewLoop loop(settings);
+  servo::LoopSettings settings;
+  servo::ViewLoop loop(settings);
   (void)stay(loop, 1);
   (void)loop.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
-  LoopStep s = loop.step(observed(std::nullopt, at(away), 0.0), dt);
-  EXPECT_EQ(s.status, StepStatus::ObjectLost);
-  EXPECT_EQ(s.guard, Guard::ObjectLost);
-  EXPECT_EQ(s.mode, LoopMode::WayBack);
-  EXPECT_EQ(s.proposer, Proposer::BestSeen);
+  servo::LoopStep s = loop.step(observed(std::nullopt, at(away), 0.0), dt);
+  EXPECT_EQ(s.status, servo::StepStatus::ObjectLost);
+  EXPECT_EQ(s.guard, servo::Guard::ObjectLost);
+  EXPECT_EQ(s.mode, servo::LoopMode::WayBack);
+  EXPECT_EQ(s.proposer, servo::Proposer::BestSeen);
   ASSERT_TRUE(s.target);
   EXPECT_LT(s.target->norm(), 1e-12);
-  EXPECT_NE(s.safety, SafetyAction::ObjectLost);
+  EXPECT_NE(s.safety, servo::SafetyAction::ObjectLost);
   EXPECT_LT(s.velocity[0], -1e-3);  // camera frame = world frame here: towards the origin
   EXPECT_LE(speed(s.velocity), settings.safety.max_linear_speed + 1e-12);
   s = loop.step(observed(std::nullopt, at(Eigen::Vector3d(0.005, 0, 0)), 0.0), dt);
-  EXPECT_EQ(s.guard, Guard::BackThere);
-  EXPECT_EQ(s.mode, LoopMode::Waiting);
+  EXPECT_EQ(s.guard, servo::Guard::BackThere);
+  EXPECT_EQ(s.mode, servo::LoopMode::Waiting);
   EXPECT_FALSE(s.target);
-  EXPECT_EQ(s.safety, SafetyAction::ObjectLost);
+  EXPECT_EQ(s.safety, servo::SafetyAction::ObjectLost);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
   // Found again there: it holds that view (guard object_found), until t0 is clear.
   s = loop.step(observed(occluded_patch(), at(Eigen::Vector3d(0.005, 0, 0)), 0.0, 100.0), dt);
-  EXPECT_EQ(s.guard, Guard::ObjectFound);
-  EXPECT_EQ(s.mode, LoopMode::Hold);
+  EXPECT_EQ(s.guard, servo::Guard::ObjectFound);
+  EXPECT_EQ(s.mode, servo::LoopMode::Hold);
   s = loop.step(observed(patch(false), at(Eigen::Vector3d(0.005, 0, 0)), 0.0, 100.0), dt);
-  EXPECT_EQ(s.guard, Guard::T0Clear);
-  EXPECT_EQ(s.mode, LoopMode::Pursue);
-  EXPECT_EQ(s.proposer, Proposer::Estimate);
+  EXPECT_EQ(s.guard, servo::Guard::T0Clear);
+  EXPECT_EQ(s.mode, servo::LoopMode::Pursue);
+  EXPECT_EQ(s.proposer, servo::Proposer::Estimate);
 
   // Without the retreat (retreat_drop = 0), or lost where the camera has
   // been for longer than 0.5 s (the best view since is here), a lost object
   // stops the camera.
   settings.retreat.drop = 0.0;
-  ViewLoop no_retreat(settings);
+  servo::ViewLoop no_retreat(settings);
   (void)stay(no_retreat, 1);
   (void)no_retreat.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
   s = no_retreat.step(observed(std::nullopt, at(away), 0.0), dt);
-  EXPECT_EQ(s.mode, LoopMode::Lost);
+  EXPECT_EQ(s.mode, servo::LoopMode::Lost);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
-  ViewLoop late(LoopSettings{});
+  servo::ViewLoop late(servo::LoopSettings{});
   (void)stay(late, 1);
   for (int k = 0; k < 20; ++k) (void)late.step(observed(occluded_patch(), at(away), 0.0, 95.0), dt);
   s = late.step(observed(std::nullopt, at(away), 0.0), dt);
-  EXPECT_EQ(s.guard, Guard::BackThere);  // the origin is too long ago: the best view of the last 0.5 s is here
-  EXPECT_EQ(s.mode, LoopMode::Waiting);
+  EXPECT_EQ(s.guard, servo::Guard::BackThere);  // the origin is too long ago: the best view of the last 0.5 s is here
+  EXPECT_EQ(s.mode, servo::LoopMode::Waiting);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
 }
@@ -316,13 +316,13 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
   ViewProblem p = occluded_patch();
   p.occluders.conservativeResize(3, 9 + 30);
   for (int i = 0; i < 30; ++i) p.occluders.col(9 + i) << -0.2 - 0.02 * (i % 10), 0.02 * (i / 10), 0.3;
-  const auto tracked_points = [](const LoopStep& s) {
+  const auto tracked_points = [](const servo::LoopStep& s) {
     Eigen::Index n = 0;
     for (const OccluderTrack& t : s.tracks) n += t.points.cols();
     return n;
   };
-  ViewLoop with(LoopSettings{}), all(LoopSettings{});
-  LoopStep a, b;
+  servo::ViewLoop with(servo::LoopSettings{}), all(servo::LoopSettings{});
+  servo::LoopStep a, b;
   for (int k = 0; k < 3; ++k) {
     a = with.step(observed(p, vpHomogeneousMatrix(), 0.0, std::nullopt, 30), 1.0 / 30.0);
     b = all.step(observed(p, vpHomogeneousMatrix(), 0.0), 1.0 / 30.0);
@@ -334,7 +334,7 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
   ASSERT_TRUE(a.estimate && b.estimate);
   EXPECT_EQ(a.estimate->occlusion_points, b.estimate->occlusion_points);
   // More than the problem holds is all of it.
-  const LoopStep c = with.step(observed(p, vpHomogeneousMatrix(), 0.0, std::nullopt, 1000), 1.0 / 30.0);
+  const servo::LoopStep c = with.step(observed(p, vpHomogeneousMatrix(), 0.0, std::nullopt, 1000), 1.0 / 30.0);
   EXPECT_EQ(tracked_points(c), 0);
   EXPECT_EQ(c.presumed_occluders, 39);
 }
@@ -347,7 +347,7 @@ TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {
 // none of it from the origin.
 struct Post {
   Eigen::Vector3d on, off;
-  Proposer by = Proposer::None;  ///< whose view `on` is
+  servo::Proposer by = servo::Proposer::None;  ///< whose view `on` is
   [[nodiscard]] bool goes() const { return (on - off).norm() < 1e-9; }
   /// Holds, or heads more than 45 deg off the way without the look-ahead.
   [[nodiscard]] bool turns_off() const {
@@ -355,7 +355,7 @@ struct Post {
   }
 };
 Post with_a_post(double along, double side, bool t0_was_clear = false) {
-  ViewLoop plain(LoopSettings{});
+  servo::ViewLoop plain(servo::LoopSettings{});
   const Eigen::Vector3d away = stay(plain, 1);
   const Eigen::Vector3d object(0, 0, 0.5);
   const Eigen::Vector3d way = Eigen::AngleAxisd(side, Eigen::Vector3d::UnitZ()) * away.normalized();
@@ -363,13 +363,13 @@ Post with_a_post(double along, double side, bool t0_was_clear = false) {
   ViewProblem p = occluded_patch();
   p.occluders.conservativeResize(3, 10);
   p.occluders.col(9) = there + 0.05 * (object - there).normalized();
-  Proposer by = Proposer::None;
+  servo::Proposer by = servo::Proposer::None;
   const auto target = [&](bool look_ahead) {
-    LoopSettings settings;
+    servo::LoopSettings settings;
     settings.retreat.look_ahead = look_ahead;
-    ViewLoop loop(settings);
+    servo::ViewLoop loop(settings);
     if (t0_was_clear) see_t0_clear(loop);
-    const LoopStep s = loop.step(observed(p, vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);
+    const servo::LoopStep s = loop.step(observed(p, vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0);
     EXPECT_TRUE(s.target);
     if (look_ahead) by = s.proposer;
     return s.target.value_or(Eigen::Vector3d::Constant(NAN));
@@ -389,15 +389,15 @@ TEST(ViewLoop, ItDoesNotGoWhereItsOwnMotionWouldHideTheObject) {
   const Post blocked = with_a_post(0.025, 0.0);
   EXPECT_FALSE(blocked.goes());
   EXPECT_TRUE(blocked.turns_off());
-  EXPECT_TRUE(blocked.by == Proposer::Here || blocked.by == Proposer::Climb) << to_string(blocked.by);
-  EXPECT_NE(with_a_post(0.07, 0.0).by, Proposer::Here);
+  EXPECT_TRUE(blocked.by == servo::Proposer::Here || blocked.by == servo::Proposer::Climb) << to_string(blocked.by);
+  EXPECT_NE(with_a_post(0.07, 0.0).by, servo::Proposer::Here);
   EXPECT_TRUE(with_a_post(0.025, EIGEN_PI / 2).goes());
   EXPECT_TRUE(with_a_post(0.07, 0.0).goes());
   EXPECT_TRUE(with_a_post(0.025, 0.0, true).goes());
 }
 
 TEST(ViewLoop, SettingsByNameAreValidated) {
-  LoopSettings s;
+  servo::LoopSettings s;
   loop_settings_table().set(s, "max_linear_speed", "0.3");
   EXPECT_EQ(s.controller.max_linear_speed, 0.3);
   EXPECT_EQ(s.safety.max_linear_speed, 0.3);  // one setting, both limits
@@ -434,11 +434,11 @@ class Timestamps : public FrameSource {
 
 TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
   Timestamps source({0.0, 1.0 / 30, 2.0 / 30, 5.0, 5.0 + 1.0 / 30});
-  FreeFlyingCamera robot{vpHomogeneousMatrix()};
-  RobotLoopOptions options;
+  servo::FreeFlyingCamera robot{vpHomogeneousMatrix()};
+  servo::RobotLoopOptions options;
   Fixed observer(patch(true));
-  std::vector<SafetyAction> actions;
-  const RobotLoopSummary summary = run_on_robot(source, observer, robot, LoopSettings{}, options, [&](const RobotLoopFrame& f) {
+  std::vector<servo::SafetyAction> actions;
+  const servo::RobotLoopSummary summary = run_on_robot(source, observer, robot, servo::LoopSettings{}, options, [&](const servo::RobotLoopFrame& f) {
     actions.push_back(f.step->safety);
     ASSERT_NE(f.observation, nullptr);
     EXPECT_DOUBLE_EQ(f.observation->age, f.frame_age);
@@ -447,23 +447,23 @@ TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
   EXPECT_EQ(summary.lost, 0);
   ASSERT_EQ(actions.size(), 5U);
   EXPECT_FALSE(stops(actions[1]));
-  EXPECT_EQ(actions[3], SafetyAction::StaleFrame);  // 5 s after the previous frame
+  EXPECT_EQ(actions[3], servo::SafetyAction::StaleFrame);  // 5 s after the previous frame
   EXPECT_FALSE(stops(actions[4]));
 }
 
 TEST(RobotLoop, TheStopFlagEndsTheRunAndMaxDurationTheSource) {
   volatile std::sig_atomic_t stop = 1;
   Timestamps source({0.0, 0.1, 0.2});
-  FreeFlyingCamera robot{vpHomogeneousMatrix()};
-  RobotLoopOptions options;
+  servo::FreeFlyingCamera robot{vpHomogeneousMatrix()};
+  servo::RobotLoopOptions options;
   Fixed observer(patch(false));
   options.stop = &stop;
-  RobotLoopSummary summary = run_on_robot(source, observer, robot, LoopSettings{}, options);
+  servo::RobotLoopSummary summary = run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 0);
   EXPECT_TRUE(summary.stopped);
   stop = 0;
   options.max_duration = 0.15;
-  summary = run_on_robot(source, observer, robot, LoopSettings{}, options);
+  summary = run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 2);  // 0 and 0.1 s; the frame at 0.2 s is past the duration
   EXPECT_FALSE(summary.stopped);
 }

@@ -17,7 +17,7 @@
 #include <unordered_map>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 /// \brief The working volume: points outside it are dropped before anything else.
 struct CropVolume {
@@ -92,4 +92,15 @@ class CloudBuilder {
 /// \throws std::invalid_argument naming the mismatch.
 void check_frame(const RgbdFrame& frame);
 
+}  // namespace ofv::perception
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::perception::.
+namespace ofv {
+using CloudBuilder [[deprecated("use ofv::perception::CloudBuilder")]] = perception::CloudBuilder;
+using CloudSettings [[deprecated("use ofv::perception::CloudSettings")]] = perception::CloudSettings;
+using CropVolume [[deprecated("use ofv::perception::CropVolume")]] = perception::CropVolume;
+using WorldCloud [[deprecated("use ofv::perception::WorldCloud")]] = perception::WorldCloud;
+using perception::check_frame;
 }  // namespace ofv
+/// \endcond

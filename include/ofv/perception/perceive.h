@@ -6,8 +6,8 @@
  *
  * \code
  * auto source = ofv::open_source("recording.oni");
- * const ofv::PerceiveSummary s = ofv::perceive(*source, ofv::PerceptionSettings{},
- *     ofv::EstimatorSettings{}, -1, [](const ofv::PerceivedFrame& f) {
+ * const ofv::perception::PerceiveSummary s = ofv::perception::perceive(*source, ofv::perception::PerceptionSettings{},
+ *     ofv::EstimatorSettings{}, -1, [](const ofv::perception::PerceivedFrame& f) {
  *       if (f.estimate) std::cout << f.index << ": " << f.estimate->tf.transpose() << '\n';
  *     });
  * \endcode
@@ -25,7 +25,7 @@
 #include <functional>
 #include <optional>
 
-namespace ofv {
+namespace ofv::perception {
 
 /// \brief One frame as perceive() saw it: what the front end found and the view estimated.
 struct PerceivedFrame {
@@ -87,4 +87,13 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
                          const EstimatorSettings& settings, long max_frames,
                          const std::function<void(const PerceivedFrame&)>& observer);
 
+}  // namespace ofv::perception
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::perception::.
+namespace ofv {
+using perception::perceive;
+using PerceiveSummary [[deprecated("use ofv::perception::PerceiveSummary")]] = perception::PerceiveSummary;
+using PerceivedFrame [[deprecated("use ofv::perception::PerceivedFrame")]] = perception::PerceivedFrame;
 }  // namespace ofv
+/// \endcond

@@ -19,7 +19,7 @@
 
 #include <string>
 
-namespace ofv {
+namespace ofv::perception {
 
 /**
  * \brief The frame's record as JSON text.
@@ -41,4 +41,12 @@ namespace ofv {
 void write_perceived_frame(const std::string& dir, const PerceivedFrame& frame,
                            const EstimatorParams& params, bool picture, double r_sphere);
 
+}  // namespace ofv::perception
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::perception::.
+namespace ofv {
+using perception::perceived_frame_json;
+using perception::write_perceived_frame;
 }  // namespace ofv
+/// \endcond

@@ -9,10 +9,10 @@
  * one object through a sequence of frames:
  *
  * \code
- * ofv::Perception perception(ofv::PerceptionSettings{});   // default start: see ObjectSelection
+ * ofv::perception::Perception perception(ofv::perception::PerceptionSettings{});   // default start: see ObjectSelection
  * while (auto frame = source.next()) {
- *   const ofv::PerceptionResult r = perception.process(*frame);
- *   if (r.status == ofv::TrackingStatus::Lost) continue;
+ *   const ofv::perception::PerceptionResult r = perception.process(*frame);
+ *   if (r.status == ofv::perception::TrackingStatus::Lost) continue;
  *   const ofv::ViewEstimate e = ofv::estimate_view(r.problem, ofv::EstimatorSettings{});
  * }
  * \endcode
@@ -37,7 +37,14 @@
 #include <utility>
 #include <vector>
 
-namespace ofv {
+/**
+ * \namespace ofv::perception
+ * \brief The RGB-D front end (component `perception`): clouds, supervoxels,
+ *        classes and tracking, its scores against labelled frames, its
+ *        pictures and perceive(). The names of ofv 0.1 in `ofv`
+ *        (`ofv::Perception`, ...) remain for one release as deprecated aliases.
+ */
+namespace ofv::perception {
 
 /// \brief Settings of the supervoxel stage (pcl::SupervoxelClustering).
 struct SupervoxelSettings {
@@ -348,4 +355,28 @@ class PerceptionObserver final : public Observer {
   PerceptionResult last_;
 };
 
+}  // namespace ofv::perception
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::perception::.
+namespace ofv {
+using Perception [[deprecated("use ofv::perception::Perception")]] = perception::Perception;
+using PerceptionObserver [[deprecated("use ofv::perception::PerceptionObserver")]] = perception::PerceptionObserver;
+using SupervoxelClass [[deprecated("use ofv::perception::SupervoxelClass")]] = perception::SupervoxelClass;
+using TrackingStatus [[deprecated("use ofv::perception::TrackingStatus")]] = perception::TrackingStatus;
+using perception::observation;
+using perception::perception_settings;
+using perception::perception_settings_table;
+using ObjectSelection [[deprecated("use ofv::perception::ObjectSelection")]] = perception::ObjectSelection;
+using OrientedBox [[deprecated("use ofv::perception::OrientedBox")]] = perception::OrientedBox;
+using PerceptionCounts [[deprecated("use ofv::perception::PerceptionCounts")]] = perception::PerceptionCounts;
+using PerceptionResult [[deprecated("use ofv::perception::PerceptionResult")]] = perception::PerceptionResult;
+using PerceptionSettings [[deprecated("use ofv::perception::PerceptionSettings")]] = perception::PerceptionSettings;
+using PerceptionTimings [[deprecated("use ofv::perception::PerceptionTimings")]] = perception::PerceptionTimings;
+using SupervoxelInfo [[deprecated("use ofv::perception::SupervoxelInfo")]] = perception::SupervoxelInfo;
+using SupervoxelSettings [[deprecated("use ofv::perception::SupervoxelSettings")]] = perception::SupervoxelSettings;
+using TrackingSettings [[deprecated("use ofv::perception::TrackingSettings")]] = perception::TrackingSettings;
+using perception::to_string;
+using perception::validate;
 }  // namespace ofv
+/// \endcond

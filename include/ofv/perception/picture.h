@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-namespace ofv {
+namespace ofv::perception {
 
 /**
  * \brief Draws the scene of one frame and saves it as an 800 x 600 PNG.
@@ -37,4 +37,11 @@ void save_perception_picture(const std::string& path, const RgbdFrame& frame,
                              const PerceptionResult& result,
                              const std::optional<ViewEstimate>& estimate, double r_sphere);
 
+}  // namespace ofv::perception
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::perception::.
+namespace ofv {
+using perception::save_perception_picture;
 }  // namespace ofv
+/// \endcond

@@ -51,7 +51,7 @@
 #include <unordered_map>
 #include <vector>
 
-namespace ofv {
+namespace ofv::perception {
 
 /**
  * \brief A labelled frame's pixels on a world voxel grid: the label most of
@@ -141,4 +141,15 @@ struct PerceptionScores {
  */
 [[nodiscard]] double labelled_shown_area(const RgbdFrame& frame, const PerceptionSettings& settings);
 
+}  // namespace ofv::perception
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::perception::.
+namespace ofv {
+using VoxelLabels [[deprecated("use ofv::perception::VoxelLabels")]] = perception::VoxelLabels;
+using perception::labelled_shown_area;
+using perception::score_perception;
+using PerceptionScores [[deprecated("use ofv::perception::PerceptionScores")]] = perception::PerceptionScores;
+using PerceptionTruth [[deprecated("use ofv::perception::PerceptionTruth")]] = perception::PerceptionTruth;
 }  // namespace ofv
+/// \endcond

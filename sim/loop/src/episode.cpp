@@ -69,9 +69,9 @@ SettingsTable<EpisodeSetup> make_table() {
 }
 
 // select=labels: the scenario's object as a frame's labels show it.
-ObjectSelection object_in(const std::vector<std::uint16_t>& labels) {
-  ObjectSelection selection;
-  selection.mode = ObjectSelection::Mode::Image;
+perception::ObjectSelection object_in(const std::vector<std::uint16_t>& labels) {
+  perception::ObjectSelection selection;
+  selection.mode = perception::ObjectSelection::Mode::Image;
   selection.mask.resize(labels.size());
   std::transform(labels.begin(), labels.end(), selection.mask.begin(),
                  [](std::uint16_t label) { return label == sim::kLabelObject ? 1 : 0; });
@@ -97,9 +97,9 @@ ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const E
 
 
 // The front end's output against the frame's labels and the object's true surface.
-PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, const sim::Renderer& renderer,
-                       const PerceptionSettings& settings) {
-  PerceptionTruth truth;
+perception::PerceptionScores score(const RgbdFrame& frame, const perception::PerceptionResult& result, const sim::Renderer& renderer,
+                       const perception::PerceptionSettings& settings) {
+  perception::PerceptionTruth truth;
   truth.centroid = frame.object_centroid;
   truth.r_sphere = settings.r_sphere;
   truth.surface = renderer.object_surface();
@@ -109,7 +109,7 @@ PerceptionScores score(const RgbdFrame& frame, const PerceptionResult& result, c
 // Ground truth as the loop sees it: the simulator's problem (every occluder
 // in the sphere, seen or not) and, as the shown area, what a front end that
 // classified every pixel right would report; no other truth.
-Observation truth_observation(const RgbdFrame& frame, ViewProblem problem, const PerceptionSettings& settings) {
+Observation truth_observation(const RgbdFrame& frame, ViewProblem problem, const perception::PerceptionSettings& settings) {
   Observation o;
   o.wMc = frame.wMc;
   o.problem = std::move(problem);
@@ -120,7 +120,7 @@ Observation truth_observation(const RgbdFrame& frame, ViewProblem problem, const
 // The same for frames rendered elsewhere (a live simulated sensor).
 class TruthObserver final : public Observer {
  public:
-  TruthObserver(const sim::Renderer& renderer, const EstimatorSettings& estimator, const PerceptionSettings& settings)
+  TruthObserver(const sim::Renderer& renderer, const EstimatorSettings& estimator, const perception::PerceptionSettings& settings)
       : renderer_(renderer), estimator_(estimator), settings_(settings) {}
   Observation observe(const RgbdFrame& frame) override {
     return truth_observation(frame, renderer_.ground_truth_problem(frame.wMc, estimator_.r_seed, estimator_.r_sphere),
@@ -130,11 +130,11 @@ class TruthObserver final : public Observer {
  private:
   const sim::Renderer& renderer_;
   EstimatorSettings estimator_;
-  PerceptionSettings settings_;
+  perception::PerceptionSettings settings_;
 };
 
 // What the loop did.
-void record_step(StepRecord& rec, const LoopStep& step) {
+void record_step(StepRecord& rec, const servo::LoopStep& step) {
   rec.times.estimate = step.estimate_s;
   rec.times.control = step.control_s;
   rec.status = step.status;
@@ -179,9 +179,9 @@ long episode_frames(const EpisodeSetup& setup) {
 
 }  // namespace
 
-PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
-  PerceptionSettings settings = perception_settings(setup.loop.estimator.resolve(), setup.front_end);
-  if (setup.perception == PerceptionMode::Labels) settings.classes = PerceptionSettings::Classes::Labels;
+perception::PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
+  perception::PerceptionSettings settings = perception_settings(setup.loop.estimator.resolve(), setup.front_end);
+  if (setup.perception == PerceptionMode::Labels) settings.classes = perception::PerceptionSettings::Classes::Labels;
   return settings;
 }
 
@@ -210,7 +210,7 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
   for (const auto& [k, v] : scenario.controller) episode_settings_table().set(s, k == "law" ? "controller" : k, v);
   episode_settings_table().apply(s, settings);
   s.scenario = sim::with_seed(scenario, s.seed);
-  (void)ViewLoop(s.loop);  // validates every loop setting
+  (void)servo::ViewLoop(s.loop);  // validates every loop setting
   // Valid one by one, meaningless together: every frame older than the
   // stale timeout when its command is sent, the robot would never move.
   const double age = (1.0 + s.latency) / s.scenario.rate;
@@ -221,7 +221,7 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
                                 " s old when its command is sent, older than stale_timeout, and the robot would "
                                 "never move; lower latency or raise stale_timeout");
   }
-  if (s.real_time && s.robot == RobotKind::Camera) {
+  if (s.real_time && s.robot == servo::RobotKind::Camera) {
     throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");
   }
   return s;
@@ -232,11 +232,11 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   const long steps = episode_frames(setup);
   const double dt = 1.0 / scenario.rate;
 
-  ViewLoop loop(setup.loop);
+  servo::ViewLoop loop(setup.loop);
   sim::Renderer renderer(scenario);
-  std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
-  const PerceptionSettings front_end = front_end_settings(setup);
-  std::optional<PerceptionObserver> perception;  // full, labels: made on the first frame, which may point out the object
+  std::unique_ptr<servo::CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
+  const perception::PerceptionSettings front_end = front_end_settings(setup);
+  std::optional<perception::PerceptionObserver> perception;  // full, labels: made on the first frame, which may point out the object
 
   // Commands on their way to the robot, oldest first.
   std::deque<vpColVector> in_flight(static_cast<std::size_t>(setup.latency), vpColVector(6, 0.0));
@@ -261,7 +261,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 
     start = Clock::now();
     if (setup.perception != PerceptionMode::GroundTruth && !perception) {
-      PerceptionSettings settings = front_end;
+      perception::PerceptionSettings settings = front_end;
       if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.frame.labels);
       perception.emplace(settings);
     }
@@ -272,7 +272,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 
     // The frame is as old as 1 + latency periods when its command is replaced.
     observation.age = dt * (1 + setup.latency);
-    const LoopStep step = loop.step(observation, dt);
+    const servo::LoopStep step = loop.step(observation, dt);
     record_step(rec, step);
 
     outcome.steps.push_back(rec);
@@ -292,21 +292,21 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 }
 
 EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomic_t* stop,
-                        const std::function<void(const RobotLoopFrame&)>& observer) {
-  if (setup.robot == RobotKind::Camera) {
+                        const std::function<void(const servo::RobotLoopFrame&)>& observer) {
+  if (setup.robot == servo::RobotKind::Camera) {
     throw std::invalid_argument("a rehearsal needs robot viper850 or afma6 (ViSP's threaded simulators), not camera");
   }
   (void)episode_frames(setup);
   const EstimatorSettings estimator = setup.loop.estimator.resolve();
   sim::Renderer renderer(setup.scenario);
-  std::unique_ptr<CameraRobot> robot = make_robot(setup.robot, to_visp(setup.scenario.wMc_start), /*real_time=*/true);
+  std::unique_ptr<servo::CameraRobot> robot = make_robot(setup.robot, to_visp(setup.scenario.wMc_start), /*real_time=*/true);
   sim::LiveSource source(renderer, [&robot] { return to_eigen(robot->wMc()); }, setup.duration);
 
-  RobotLoopOptions options;
+  servo::RobotLoopOptions options;
   options.wall_clock_age = true;
   options.first_period = 1.0 / setup.scenario.rate;
   options.stop = stop;
-  PerceptionSettings front_end = front_end_settings(setup);
+  perception::PerceptionSettings front_end = front_end_settings(setup);
   if (setup.perception != PerceptionMode::GroundTruth && setup.select == ObjectSelect::Labels) {
     // The first frame's labels, rendered from where the arm starts.
     sim::RenderedFrame first;
@@ -316,12 +316,12 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     front_end.selection = object_in(first.frame.labels);
   }
   TruthObserver truth(renderer, estimator, front_end);
-  std::optional<PerceptionObserver> perception;
+  std::optional<perception::PerceptionObserver> perception;
   if (setup.perception != PerceptionMode::GroundTruth) perception.emplace(front_end);
   Observer& observer_of_frames = perception ? static_cast<Observer&>(*perception) : truth;
 
   EpisodeOutcome outcome;
-  (void)run_on_robot(source, observer_of_frames, *robot, setup.loop, options, [&](const RobotLoopFrame& f) {
+  (void)run_on_robot(source, observer_of_frames, *robot, setup.loop, options, [&](const servo::RobotLoopFrame& f) {
     StepRecord rec;
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;

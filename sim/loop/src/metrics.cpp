@@ -25,7 +25,7 @@ std::vector<double> step_durations(const std::vector<StepRecord>& steps) {
 }
 
 // One score over the steps: mean and worst (lowest when `higher_is_better`).
-ScoreSummary summarise_score(const std::vector<StepRecord>& steps, std::optional<double> PerceptionScores::*score,
+ScoreSummary summarise_score(const std::vector<StepRecord>& steps, std::optional<double> perception::PerceptionScores::*score,
                              bool higher_is_better) {
   ScoreSummary out;
   double sum = 0.0;
@@ -49,12 +49,12 @@ ScoreSummary summarise_score(const std::vector<StepRecord>& steps, std::optional
 
 PerceptionSummary summarise_perception(const std::vector<StepRecord>& steps) {
   PerceptionSummary p;
-  p.object_precision = summarise_score(steps, &PerceptionScores::object_precision, true);
-  p.object_recall = summarise_score(steps, &PerceptionScores::object_recall, true);
-  p.occluder_precision = summarise_score(steps, &PerceptionScores::occluder_precision, true);
-  p.occluder_recall = summarise_score(steps, &PerceptionScores::occluder_recall, true);
-  p.centroid_error = summarise_score(steps, &PerceptionScores::centroid_error, false);
-  p.hidden_error = summarise_score(steps, &PerceptionScores::hidden_error, false);
+  p.object_precision = summarise_score(steps, &perception::PerceptionScores::object_precision, true);
+  p.object_recall = summarise_score(steps, &perception::PerceptionScores::object_recall, true);
+  p.occluder_precision = summarise_score(steps, &perception::PerceptionScores::occluder_precision, true);
+  p.occluder_recall = summarise_score(steps, &perception::PerceptionScores::occluder_recall, true);
+  p.centroid_error = summarise_score(steps, &perception::PerceptionScores::centroid_error, false);
+  p.hidden_error = summarise_score(steps, &perception::PerceptionScores::hidden_error, false);
   for (const StepRecord& s : steps) {
     const bool scored = s.perception.object_recall.has_value();
     p.lost_half_visible += scored && !s.perception.centroid_error && s.visible_fraction >= 0.5 ? 1 : 0;
@@ -260,9 +260,9 @@ std::string trajectory_csv_row(const StepRecord& s) {
       << s.angular_error_deg << ',' << s.sphere_distance_error << ',' << s.occluders_in_sphere
       << ',' << s.occluders_in_view << ',' << s.tracks << ',' << s.fastest_track_speed << ',' << s.predicted_occluders << ',' << s.times.render << ',' << s.times.perception << ',' << s.times.estimate << ','
       << s.times.control;
-  for (const auto score : {&PerceptionScores::object_precision, &PerceptionScores::object_recall,
-                           &PerceptionScores::occluder_precision, &PerceptionScores::occluder_recall,
-                           &PerceptionScores::centroid_error, &PerceptionScores::hidden_error}) {
+  for (const auto score : {&perception::PerceptionScores::object_precision, &perception::PerceptionScores::object_recall,
+                           &perception::PerceptionScores::occluder_precision, &perception::PerceptionScores::occluder_recall,
+                           &perception::PerceptionScores::centroid_error, &perception::PerceptionScores::hidden_error}) {
     out << ',';
     if (s.perception.*score) out << *(s.perception.*score);
   }

@@ -107,12 +107,12 @@ struct DisplayInput {
   const RgbdFrame* frame = nullptr;
   CameraIntrinsics intrinsics;           ///< used when `frame` is nullptr
   const Observation* observation = nullptr;  ///< supervoxels and occluders seen and presumed (nullptr: none)
-  const LoopStep* step = nullptr;  ///< what ofv::ViewLoop did (nullptr: a loop of the caller's own)
+  const servo::LoopStep* step = nullptr;  ///< what ofv::servo::ViewLoop did (nullptr: a loop of the caller's own)
   /// The object's centroid when the step has no estimate (simulation: the true one).
   std::optional<Eigen::Vector3d> centroid;
   std::optional<Eigen::Vector3d> target;   ///< the view driven to, when there is no step
   std::optional<double> visible_fraction;  ///< the true visible fraction (simulation only)
-  std::optional<StepStatus> status;        ///< default: the step's (none without a step)
+  std::optional<servo::StepStatus> status;        ///< default: the step's (none without a step)
   /// The camera twist sent (v, w) [m/s, rad/s]; default: the step's velocity.
   std::optional<vpColVector> velocity;
 };
@@ -140,8 +140,8 @@ class LiveDisplay {
   /// \brief show() for a step of ofv::run_episode (true visible fraction and centroid from the
   /// simulator).
   bool observe(const StepRecord& record, const StepDetail& detail);
-  /// \brief show() for a frame of ofv::run_on_robot or ofv::rehearse (no ground truth).
-  bool observe(const RobotLoopFrame& frame);
+  /// \brief show() for a frame of ofv::servo::run_on_robot or ofv::rehearse (no ground truth).
+  bool observe(const servo::RobotLoopFrame& frame);
 
   /// \brief Called when a pause starts, before waiting (e.g. send the robot a zero velocity).
   void set_pause_hook(std::function<void()> hook);

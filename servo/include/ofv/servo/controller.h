@@ -14,7 +14,7 @@
 #include <memory>
 #include <optional>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief Settings of ViewController. Speeds in the camera frame.
 struct ControllerSettings {
@@ -93,4 +93,13 @@ class ViewController {
 /// \brief Scales the linear and angular parts of a twist to the limits (direction kept).
 [[nodiscard]] vpColVector saturate(const vpColVector& v, double max_linear, double max_angular);
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using ControllerSettings [[deprecated("use ofv::servo::ControllerSettings")]] = servo::ControllerSettings;
+using ViewController [[deprecated("use ofv::servo::ViewController")]] = servo::ViewController;
+using servo::validate;
 }  // namespace ofv
+/// \endcond

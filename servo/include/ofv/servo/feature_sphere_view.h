@@ -42,7 +42,7 @@
  * direction is as good and P f = 0; ViewController nudges the target there.
  *
  * \code
- * ofv::FeatureSphereView s, s_star;        // s_star stays 0
+ * ofv::servo::FeatureSphereView s, s_star;        // s_star stays 0
  * s.build(cMw, centroid_w, tf_w, 0.5);
  * vpServo task;
  * task.setServo(vpServo::EYEINHAND_CAMERA);
@@ -57,7 +57,7 @@
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/visual_features/vpBasicFeature.h>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief The sphere-view feature (see the file documentation for L_s).
 class FeatureSphereView : public vpBasicFeature {
@@ -104,4 +104,11 @@ class FeatureSphereView : public vpBasicFeature {
   double r_ = 0.5;
 };
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using FeatureSphereView [[deprecated("use ofv::servo::FeatureSphereView")]] = servo::FeatureSphereView;
 }  // namespace ofv
+/// \endcond

@@ -7,7 +7,7 @@
 
 #include <vector>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief What the loop did with one frame.
 enum class StepStatus {
@@ -92,4 +92,18 @@ enum class Proposer {
 /// \brief The word in files and on the terminal, e.g. estimate, warm_start.
 [[nodiscard]] const char* to_string(Proposer proposer);
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using Guard [[deprecated("use ofv::servo::Guard")]] = servo::Guard;
+using LoopMode [[deprecated("use ofv::servo::LoopMode")]] = servo::LoopMode;
+using Proposer [[deprecated("use ofv::servo::Proposer")]] = servo::Proposer;
+using SafetyAction [[deprecated("use ofv::servo::SafetyAction")]] = servo::SafetyAction;
+using StepStatus [[deprecated("use ofv::servo::StepStatus")]] = servo::StepStatus;
+using LoopTransition [[deprecated("use ofv::servo::LoopTransition")]] = servo::LoopTransition;
+using servo::loop_transitions;
+using servo::to_string;
 }  // namespace ofv
+/// \endcond

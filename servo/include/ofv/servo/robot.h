@@ -29,7 +29,7 @@
 #include <memory>
 #include <string>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief The simulated robots ofv can step (real drivers come through VispRobot).
 enum class RobotKind {
@@ -193,4 +193,20 @@ class ThreadedArm : public CameraRobot {
 [[nodiscard]] std::unique_ptr<CameraRobot> make_robot(RobotKind kind, const vpHomogeneousMatrix& wMc_start,
                                                       bool real_time = false);
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using CameraRobot [[deprecated("use ofv::servo::CameraRobot")]] = servo::CameraRobot;
+using FreeFlyingCamera [[deprecated("use ofv::servo::FreeFlyingCamera")]] = servo::FreeFlyingCamera;
+using KinematicArm [[deprecated("use ofv::servo::KinematicArm")]] = servo::KinematicArm;
+using ThreadedArm [[deprecated("use ofv::servo::ThreadedArm")]] = servo::ThreadedArm;
+using VispRobot [[deprecated("use ofv::servo::VispRobot")]] = servo::VispRobot;
+using RobotKind [[deprecated("use ofv::servo::RobotKind")]] = servo::RobotKind;
+using RobotStep [[deprecated("use ofv::servo::RobotStep")]] = servo::RobotStep;
+using servo::make_robot;
+using servo::parse_robot_kind;
+using servo::to_string;
 }  // namespace ofv
+/// \endcond

@@ -1,8 +1,8 @@
 /**
  * \file robot_loop.h
  * \brief The closed loop on a robot: frames from a sensor or a recording →
- *        an ofv::Observer (the perception front end, ofv::PerceptionObserver)
- *        → ofv::ViewLoop → the robot, until the source ends or a stop is requested. `ofv run`, the rehearsal on ViSP's threaded
+ *        an ofv::Observer (the perception front end, ofv::perception::PerceptionObserver)
+ *        → ofv::servo::ViewLoop → the robot, until the source ends or a stop is requested. `ofv run`, the rehearsal on ViSP's threaded
  *        simulators and the real-robot tutorial use it.
  */
 #pragma once
@@ -17,7 +17,7 @@
 #include <limits>
 #include <optional>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief How run_on_robot() treats its source and robot.
 struct RobotLoopOptions {
@@ -67,10 +67,10 @@ struct RobotLoopSummary {
  * the robot is never sent a period that is not finite and >= 0 (0 with
  * such a stop), and a non-finite timestamp is not the next frame's time base.
  * \param source   the frames, read until it ends
- * \param observer makes each frame's observation (ofv::PerceptionObserver on
+ * \param observer makes each frame's observation (ofv::perception::PerceptionObserver on
  *                 a sensor; in a rehearsal, the simulator's cut-down truth).
  * \param robot    what carries the camera; sent each command
- * \param settings the loop's settings (ofv::ViewLoop)
+ * \param settings the loop's settings (ofv::servo::ViewLoop)
  * \param options  how the source and the robot are treated
  * \param on_frame sees every frame after its command is sent; may be empty.
  * \throws std::invalid_argument for invalid settings; whatever the source,
@@ -80,4 +80,14 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
                               const LoopSettings& settings, const RobotLoopOptions& options,
                               const std::function<void(const RobotLoopFrame&)>& on_frame = {});
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using servo::run_on_robot;
+using RobotLoopFrame [[deprecated("use ofv::servo::RobotLoopFrame")]] = servo::RobotLoopFrame;
+using RobotLoopOptions [[deprecated("use ofv::servo::RobotLoopOptions")]] = servo::RobotLoopOptions;
+using RobotLoopSummary [[deprecated("use ofv::servo::RobotLoopSummary")]] = servo::RobotLoopSummary;
 }  // namespace ofv
+/// \endcond

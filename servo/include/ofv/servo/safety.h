@@ -11,7 +11,7 @@
 #include <visp3/core/vpColVector.h>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief Limits of SafetyFilter (camera frame for velocities, world frame for the workspace).
 struct SafetySettings {
@@ -65,4 +65,13 @@ class SafetyFilter {
   SafetyAction action_ = SafetyAction::None;
 };
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using SafetyFilter [[deprecated("use ofv::servo::SafetyFilter")]] = servo::SafetyFilter;
+using SafetySettings [[deprecated("use ofv::servo::SafetySettings")]] = servo::SafetySettings;
+using servo::validate;
 }  // namespace ofv
+/// \endcond

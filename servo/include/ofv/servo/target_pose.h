@@ -7,7 +7,7 @@
 #include <Eigen/Geometry>
 #include <visp3/core/vpHomogeneousMatrix.h>
 
-namespace ofv {
+namespace ofv::servo {
 
 /// \brief ViSP <-> Eigen for poses (same convention: aMb maps b to a).
 [[nodiscard]] vpHomogeneousMatrix to_visp(const Eigen::Isometry3d& aMb);
@@ -29,4 +29,13 @@ namespace ofv {
 [[nodiscard]] vpHomogeneousMatrix target_pose(const Eigen::Vector3d& t, const Eigen::Vector3d& centroid,
                                               const vpHomogeneousMatrix& wMc);
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using servo::target_pose;
+using servo::to_eigen;
+using servo::to_visp;
 }  // namespace ofv
+/// \endcond

@@ -6,18 +6,18 @@
  *        camera twist and a typed status.
  *
  * Every caller uses it: the simulated episode (ofv::run_episode), `ofv run`
- * on hardware or recordings (ofv::run_on_robot), the tutorials. Perception
+ * on hardware or recordings (ofv::servo::run_on_robot), the tutorials. Perception
  * (or the simulator's ground truth) comes before it as an ofv::Observation,
  * the robot after it.
  *
  * \code
- * ofv::LoopSettings settings;                      // documented defaults
- * ofv::loop_settings_table().set(settings, "gain", "6");
- * ofv::ViewLoop loop(settings);
+ * ofv::servo::LoopSettings settings;                      // documented defaults
+ * ofv::servo::loop_settings_table().set(settings, "gain", "6");
+ * ofv::servo::ViewLoop loop(settings);
  * while (...) {
- *   ofv::Observation seen = observer.observe(frame);  // ofv::PerceptionObserver, or your own
+ *   ofv::Observation seen = observer.observe(frame);  // ofv::perception::PerceptionObserver, or your own
  *   seen.age = frame_age;
- *   const ofv::LoopStep s = loop.step(seen, dt);
+ *   const ofv::servo::LoopStep s = loop.step(seen, dt);
  *   robot.step(s.velocity, dt);
  * }
  * \endcode
@@ -41,7 +41,14 @@
 #include <optional>
 #include <vector>
 
-namespace ofv {
+/**
+ * \namespace ofv::servo
+ * \brief The ViSP side (component `servo`): the occlusion-free view as a ViSP
+ *        feature, the view controller, robots, the safety filter and the
+ *        per-frame loop (ViewLoop, run_on_robot). The names of ofv 0.1 in
+ *        `ofv` (`ofv::ViewLoop`, ...) remain for one release as deprecated aliases.
+ */
+namespace ofv::servo {
 
 /// \brief How the loop looks ahead at moving occluders.
 enum class Anticipation {
@@ -114,7 +121,7 @@ struct RetreatSettings {
   MostVisibleSettings climb;   ///< the look-ahead's climb; its margin is setting look_ahead_margin
 };
 
-/// \brief Every setting of the loop; ofv::loop_settings_table() names them.
+/// \brief Every setting of the loop; ofv::servo::loop_settings_table() names them.
 struct LoopSettings {
   EstimatorParams estimator;                  ///< the spec's settings (preset + explicit values)
   ViewMethod method = ViewMethod::Estimator;  ///< how the target view is chosen
@@ -183,7 +190,7 @@ struct LoopStep {
  * the world model is updated with the occluders seen; the proposers give
  * candidate views (the estimate, the anticipated one, the warm start from
  * the previous target, the look-ahead's climb or hold, the best view seen);
- * the mode machine moves by its named guards (ofv::Guard: one transition a
+ * the mode machine moves by its named guards (ofv::servo::Guard: one transition a
  * frame, after the object was found or lost again one more); the
  * selector picks the mode's view; the controller and the safety filter
  * turn it into a twist. Movable, not copyable.
@@ -225,4 +232,18 @@ class ViewLoop {
   std::unique_ptr<Impl> impl_;
 };
 
+}  // namespace ofv::servo
+
+/// \cond OFV_OLD_NAMES
+// The names of ofv 0.1, kept for one release: use ofv::servo::.
+namespace ofv {
+using ViewLoop [[deprecated("use ofv::servo::ViewLoop")]] = servo::ViewLoop;
+using Anticipation [[deprecated("use ofv::servo::Anticipation")]] = servo::Anticipation;
+using AnticipationSettings [[deprecated("use ofv::servo::AnticipationSettings")]] = servo::AnticipationSettings;
+using LoopSettings [[deprecated("use ofv::servo::LoopSettings")]] = servo::LoopSettings;
+using LoopStep [[deprecated("use ofv::servo::LoopStep")]] = servo::LoopStep;
+using RetreatSettings [[deprecated("use ofv::servo::RetreatSettings")]] = servo::RetreatSettings;
+using servo::loop_settings_table;
+using servo::to_string;
 }  // namespace ofv
+/// \endcond

@@ -2,7 +2,7 @@
  * \file episode.h
  * \brief One closed-loop episode: render the frame at the camera's pose →
  *        an ofv::Observation (perception full or labels, or the ground truth
- *        cut down to what a front end gives) → ofv::ViewLoop (view selection,
+ *        cut down to what a front end gives) → ofv::servo::ViewLoop (view selection,
  *        controller, safety filter) → the robot moves one frame period →
  *        next frame. Deterministic for a scenario, settings and seed.
  */
@@ -58,13 +58,13 @@ enum class ObjectSelect {
  */
 struct EpisodeSetup {
   sim::Scenario scenario;  ///< the world, already varied for `seed` (sim::with_seed)
-  LoopSettings loop;  ///< the per-frame policy: estimator, method, controller, safety
-  RobotKind robot = RobotKind::Camera;  ///< what carries the camera (setting `robot`)
+  servo::LoopSettings loop;  ///< the per-frame policy: estimator, method, controller, safety
+  servo::RobotKind robot = servo::RobotKind::Camera;  ///< what carries the camera (setting `robot`)
   PerceptionMode perception = PerceptionMode::Full;  ///< where the estimator's input comes from
   /// The front end's settings (perception full or labels) that users set
-  /// (ofv::perception_settings_table()); its sphere and seed resolution
+  /// (ofv::perception::perception_settings_table()); its sphere and seed resolution
   /// come from the estimator's.
-  PerceptionSettings front_end;
+  perception::PerceptionSettings front_end;
   ObjectSelect select = ObjectSelect::Labels;  ///< full perception, simulation only
   double duration = 0.0;  ///< [s]
   unsigned seed = 0;      ///< the scenario's k-th random world (sim::with_seed)
@@ -80,8 +80,8 @@ struct EpisodeSetup {
 
 /**
  * \brief Every setting of an episode by name: the loop's
- *        (ofv::loop_settings_table()), the front end's
- *        (ofv::perception_settings_table()) and robot, perception, select,
+ *        (ofv::servo::loop_settings_table()), the front end's
+ *        (ofv::perception::perception_settings_table()) and robot, perception, select,
  *        duration, seed, latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
@@ -99,13 +99,13 @@ struct EpisodeSetup {
 /// \brief The front end's settings of an episode: the estimator's sphere
 ///        and seed resolution, the setup's front_end, labels as classes with
 ///        perception=labels (the object selection left as the default).
-[[nodiscard]] PerceptionSettings front_end_settings(const EpisodeSetup& setup);
+[[nodiscard]] perception::PerceptionSettings front_end_settings(const EpisodeSetup& setup);
 
 /// \brief What happened in one step, for pictures and progress.
 struct StepDetail {
   const RgbdFrame* frame = nullptr;         ///< the rendered frame
   const Observation* observation = nullptr;  ///< what the loop was given
-  const LoopStep* step = nullptr;           ///< what the loop did (estimate, target, velocities)
+  const servo::LoopStep* step = nullptr;           ///< what the loop did (estimate, target, velocities)
 };
 
 /// \brief Called after every step; may be empty.
@@ -128,7 +128,7 @@ inline constexpr double kMaxEpisodeFrames = 86400.0 * 1000.0;
  *        ViSP's threaded simulator (robot viper850 or afma6) in wall-clock
  *        time, a simulated sensor rendering the scenario live from the arm's
  *        current camera pose (sim::LiveSource), and the loop of `ofv run`
- *        (ofv::run_on_robot) with its frame timing, stale frames and stop flag.
+ *        (ofv::servo::run_on_robot) with its frame timing, stale frames and stop flag.
  * \param setup    the episode, with robot viper850 or afma6.
  * \param stop     a signal handler's flag, or nullptr.
  * \param observer sees every frame (e.g. to print the commands).
@@ -136,7 +136,7 @@ inline constexpr double kMaxEpisodeFrames = 86400.0 * 1000.0;
  * \throws std::invalid_argument when the robot is not an arm.
  */
 [[nodiscard]] EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomic_t* stop,
-                                      const std::function<void(const RobotLoopFrame&)>& observer = {});
+                                      const std::function<void(const servo::RobotLoopFrame&)>& observer = {});
 
 /// \brief The runner `ofv compare` uses: loads the spec's scenario, applies its
 ///        variant and seed, runs the episode.

@@ -38,8 +38,8 @@ struct StepRecord {
   std::optional<Eigen::Vector3d> t0;  ///< estimator's initial view (none when no estimate)
   std::optional<Eigen::Vector3d> tf;  ///< estimator's final view
   std::optional<Eigen::Vector3d> target;  ///< the view the controller drove to (after hysteresis, or a baseline's)
-  StepStatus status = StepStatus::ObjectLost;  ///< what the loop did with the frame
-  SafetyAction safety = SafetyAction::None;    ///< what the safety filter did to the command
+  servo::StepStatus status = servo::StepStatus::ObjectLost;  ///< what the loop did with the frame
+  servo::SafetyAction safety = servo::SafetyAction::None;    ///< what the safety filter did to the command
   int iterations = 0;                 ///< estimator push steps
   double visible_fraction = 0.0;      ///< true fraction of the object surface seen [0, 1]
   double angular_error_deg = 0.0;     ///< eq. 9 of the real camera against the ground-truth supervoxels [deg]
@@ -50,13 +50,13 @@ struct StepRecord {
   int tracks = 0;                     ///< confirmed occluder tracks seen this frame
   double fastest_track_speed = 0.0;   ///< largest speed among them [m/s]
   int predicted_occluders = 0;        ///< predicted occluder points the target was chosen against
-  LoopMode mode = LoopMode::Lost;     ///< the loop's mode after the frame (LoopStep::mode)
-  Guard guard = Guard::None;          ///< the mode machine's transition in the frame, if any
-  Proposer proposer = Proposer::None; ///< whose view the target is
+  servo::LoopMode mode = servo::LoopMode::Lost;     ///< the loop's mode after the frame (LoopStep::mode)
+  servo::Guard guard = servo::Guard::None;          ///< the mode machine's transition in the frame, if any
+  servo::Proposer proposer = servo::Proposer::None; ///< whose view the target is
   int estimator_calls = 0;            ///< estimate_view calls of the frame
   /// The front end's output against the frame's labels (ofv/perception/scores.h);
   /// all empty when the estimator's input is the simulator's ground truth.
-  PerceptionScores perception;
+  perception::PerceptionScores perception;
   StageTimes times;                   ///< compute time of this step
 };
 
@@ -75,13 +75,13 @@ struct ScoreSummary {
 struct PerceptionSummary {
   ScoreSummary object_precision, object_recall, occluder_precision, occluder_recall;
   /** \var object_precision
-   *  \brief PerceptionScores::object_precision over the episode.
+   *  \brief perception::PerceptionScores::object_precision over the episode.
    *  \var object_recall
-   *  \brief PerceptionScores::object_recall over the episode.
+   *  \brief perception::PerceptionScores::object_recall over the episode.
    *  \var occluder_precision
-   *  \brief PerceptionScores::occluder_precision over the episode.
+   *  \brief perception::PerceptionScores::occluder_precision over the episode.
    *  \var occluder_recall
-   *  \brief PerceptionScores::occluder_recall over the episode.
+   *  \brief perception::PerceptionScores::occluder_recall over the episode.
    */
   ScoreSummary centroid_error;  ///< [m]
   ScoreSummary hidden_error;    ///< [m]

@@ -35,9 +35,9 @@ struct SceneState {
   /// true centroid; elsewhere the last one known).
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::optional<double> visible_fraction;  ///< the true visible fraction (simulation only)
-  std::optional<StepStatus> status;        ///< the loop's status (none: a loop of the caller's own)
+  std::optional<servo::StepStatus> status;        ///< the loop's status (none: a loop of the caller's own)
   const Observation* observation = nullptr;  ///< supervoxels, occluders seen and presumed; nullptr: none
-  const LoopStep* step = nullptr;          ///< estimate, target, tracks; nullptr when none
+  const servo::LoopStep* step = nullptr;          ///< estimate, target, tracks; nullptr when none
   /// The target when there is no step (a caller's own servo loop).
   std::optional<Eigen::Vector3d> target;
 };
@@ -45,7 +45,7 @@ struct SceneState {
 /**
  * \brief Draws the scene view, 640 x 480: object supervoxels and normals
  *        (blue), occluders (red; hollow where presumed beyond the image
- *        border, LoopStep::presumed_occluders), the sphere of radius `r_sphere`, C, the
+ *        border, servo::LoopStep::presumed_occluders), the sphere of radius `r_sphere`, C, the
  *        real camera and its path (white), t0 (yellow), tf (green), the
  *        target the controller follows where it differs from tf (magenta),
  *        each confirmed occluder track as an orange arrow to where it will
