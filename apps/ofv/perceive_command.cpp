@@ -126,12 +126,12 @@ Command add_perceive_command(CLI::App& app) {
             }
 
             try {
-              const perception::PerceiveSummary summary = perceive(
+              const perception::PerceiveSummary summary = perception::perceive(
                   *source, ps, settings, opt->max_frames, [&](const perception::PerceivedFrame& f) {
                     if (opt->out.empty()) {
-                      std::cout << perceived_frame_json(f, params) << '\n';
+                      std::cout << perception::perceived_frame_json(f, params) << '\n';
                     } else {
-                      write_perceived_frame(opt->out, f, params, opt->pictures, settings.r_sphere);
+                      perception::write_perceived_frame(opt->out, f, params, opt->pictures, settings.r_sphere);
                     }
                   });
               std::cerr << "ofv perceive: " << source->describe() << ": " << summary.frames

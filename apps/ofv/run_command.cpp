@@ -276,7 +276,7 @@ Command add_run_command(CLI::App& app) {
                 selection = object_selection(opt->box, opt->rect);
                 open_display();
                 const vpHomogeneousMatrix eMc = opt->emc.empty() ? vpHomogeneousMatrix() : read_eMc(opt->emc);
-                robot = real ? real_robot(opt->robot, eMc) : make_robot(setup.robot, vpHomogeneousMatrix());
+                robot = real ? real_robot(opt->robot, eMc) : servo::make_robot(setup.robot, vpHomogeneousMatrix());
                 if (!robot) {
                   throw std::invalid_argument("--robot " + opt->robot + ": unknown (simulated: camera, viper850, afma6; real drivers: " +
                                               real_drivers() + ")");
@@ -334,7 +334,7 @@ Command add_run_command(CLI::App& app) {
                 }
               };
               const servo::RobotLoopSummary summary =
-                  run_on_robot(*source, perception, *robot, setup.loop, options, first_frame);
+                  servo::run_on_robot(*source, perception, *robot, setup.loop, options, first_frame);
               lines.close();
               if (!selects_nothing.empty()) {
                 std::cerr << "ofv run: " << selects_nothing << '\n';

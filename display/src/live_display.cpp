@@ -225,7 +225,7 @@ struct LiveDisplay::Impl {
       if (target && (*target - *centroid).norm() > 1e-9) {
         try {
           servo::FeatureSphereView s;
-          s.build(to_visp(in.wMc).inverse(),
+          s.build(servo::to_visp(in.wMc).inverse(),
                   vpColVector{centroid->x(), centroid->y(), centroid->z()},
                   vpColVector{target->x(), target->y(), target->z()}, options.r_sphere);
           feature_error = s.get_s();  // s* = 0

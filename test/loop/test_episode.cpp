@@ -142,7 +142,7 @@ TEST(Episode, EveryModeChangeIsATransitionOfTheTable) {
   // found or lost again, that one and then one of the new mode's.
   const EpisodeOutcome o = run_episode(
       resolve_episode(sim::load_scenario("no-free-view"), {{"perception", "full"}, {"latency", "1"}}));
-  const auto& table = loop_transitions();
+  const auto& table = servo::loop_transitions();
   const auto edge = [&](servo::LoopMode from, servo::Guard guard, servo::LoopMode to) {
     return std::any_of(table.begin(), table.end(),
                        [&](const servo::LoopTransition& t) { return t.from == from && t.guard == guard && t.to == to; });

@@ -202,7 +202,7 @@ FaultRun replay(const FaultPlan& plan) {
   FaultRun out;
   try {
     perception::PerceptionObserver perception(front_end_settings(rec.setup));
-    out.summary = run_on_robot(source, perception, robot, rec.setup.loop, options, [&](const servo::RobotLoopFrame& f) {
+    out.summary = servo::run_on_robot(source, perception, robot, rec.setup.loop, options, [&](const servo::RobotLoopFrame& f) {
       out.actions.push_back(f.step->safety);
       out.statuses.push_back(f.step->status);
       if (f.index == plan.observer_throws_at) throw std::runtime_error("observer fault");

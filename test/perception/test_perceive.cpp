@@ -59,7 +59,7 @@ std::vector<RgbdFrame> sequence() {
 std::vector<perception::PerceivedFrame> perceive_all(FrameSource& source, long max_frames,
                                          perception::PerceiveSummary* summary = nullptr) {
   std::vector<perception::PerceivedFrame> seen;
-  const perception::PerceiveSummary s = perceive(source, perception::PerceptionSettings{}, EstimatorSettings{}, max_frames,
+  const perception::PerceiveSummary s = perception::perceive(source, perception::PerceptionSettings{}, EstimatorSettings{}, max_frames,
                                      [&seen](const perception::PerceivedFrame& f) { seen.push_back(f); });
   if (summary != nullptr) {
     *summary = s;
@@ -135,7 +135,7 @@ TEST(Perceive, RejectsInvalidSettingsBeforeReadingAFrame) {
   VectorSource source(sequence());
   perception::PerceptionSettings ps;
   ps.supervoxels.voxel_resolution = -1.0;
-  EXPECT_THROW((void)perceive(source, ps, EstimatorSettings{}, -1, nullptr), std::invalid_argument);
+  EXPECT_THROW((void)perception::perceive(source, ps, EstimatorSettings{}, -1, nullptr), std::invalid_argument);
   EXPECT_TRUE(source.next());
 }
 
@@ -146,7 +146,7 @@ TEST(PerceiveFiles, RecordHoldsTheEstimatorsSceneAndResult) {
   EstimatorParams params;
   set_param(params, "r_sphere", "0.2");
 
-  const std::string line = perceived_frame_json(seen[2], params);
+  const std::string line = perception::perceived_frame_json(seen[2], params);
   EXPECT_EQ(line.find('\n'), std::string::npos);
   const auto j = nlohmann::ordered_json::parse(line);
   std::vector<std::string> keys;
@@ -169,7 +169,7 @@ TEST(PerceiveFiles, RecordHoldsTheEstimatorsSceneAndResult) {
   EXPECT_EQ(scene.params.resolve().r_sphere, 0.2);
   EXPECT_EQ(j["estimate"], estimate_to_json(*seen[2].estimate));
 
-  const auto lost = nlohmann::ordered_json::parse(perceived_frame_json(seen[1], params));
+  const auto lost = nlohmann::ordered_json::parse(perception::perceived_frame_json(seen[1], params));
   EXPECT_EQ(lost["status"], "lost");
   EXPECT_TRUE(lost["problem"].is_null());
   EXPECT_TRUE(lost["estimate"].is_null());
@@ -184,20 +184,20 @@ TEST(PerceiveFiles, WritesTheIndentedRecordAndThePicture) {
   const fs::path dir = fs::path(test::scratch_dir()) / "perceive_files";
   fs::create_directories(dir);
   const EstimatorParams params;
-  write_perceived_frame(dir.string(), seen[2], params, true, EstimatorSettings{}.r_sphere);
-  write_perceived_frame(dir.string(), seen[1], params, false, EstimatorSettings{}.r_sphere);
+  perception::write_perceived_frame(dir.string(), seen[2], params, true, EstimatorSettings{}.r_sphere);
+  perception::write_perceived_frame(dir.string(), seen[1], params, false, EstimatorSettings{}.r_sphere);
 
   std::ifstream in(dir / "frame_000002.json");
   std::stringstream text;
   text << in.rdbuf();
-  EXPECT_EQ(text.str(), perceived_frame_json(seen[2], params, 2) + "\n");
+  EXPECT_EQ(text.str(), perception::perceived_frame_json(seen[2], params, 2) + "\n");
   const cv::Mat picture = cv::imread((dir / "frame_000002.png").string());
   EXPECT_FALSE(picture.empty());
   EXPECT_TRUE(fs::exists(dir / "frame_000001.json"));
   EXPECT_FALSE(fs::exists(dir / "frame_000001.png"));
 
   try {
-    write_perceived_frame((dir / "missing").string(), seen[2], params, false, 0.2);
+    perception::write_perceived_frame((dir / "missing").string(), seen[2], params, false, 0.2);
     FAIL() << "expected std::runtime_error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("frame_000002.json"), std::string::npos) << e.what();

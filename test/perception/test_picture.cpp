@@ -42,7 +42,7 @@ TEST(PerceptionPicture, ShowsTheObjectAndInsetsTheCameraImage) {
   ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
   const ViewEstimate e = estimate_view(r.problem, EstimatorSettings{});
   const std::string path = test::scratch_dir() + "ofv_picture.png";
-  save_perception_picture(path, frame, r, e, 0.5);
+  perception::save_perception_picture(path, frame, r, e, 0.5);
 
   const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
   ASSERT_FALSE(image.empty());
@@ -69,7 +69,7 @@ TEST(PerceptionPicture, LostObjectStillGivesAPicture) {
   perception::PerceptionResult lost;
   lost.message = "no supervoxel near the object's last state";
   const std::string path = test::scratch_dir() + "ofv_picture_lost.png";
-  save_perception_picture(path, frame, lost, std::nullopt, 0.5);
+  perception::save_perception_picture(path, frame, lost, std::nullopt, 0.5);
   const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
   ASSERT_FALSE(image.empty());
   EXPECT_EQ(image.cols, 800);
@@ -79,7 +79,7 @@ TEST(PerceptionPicture, UnwritablePathIsAnErrorNamingIt) {
   const RgbdFrame frame = test::table_and_case().render(test::vga(160), test::front_camera());
   const std::string path = test::scratch_dir() + "no/such/folder/picture.png";
   try {
-    save_perception_picture(path, frame, perception::PerceptionResult{}, std::nullopt, 0.5);
+    perception::save_perception_picture(path, frame, perception::PerceptionResult{}, std::nullopt, 0.5);
     FAIL() << "expected an error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();

@@ -107,7 +107,7 @@ TEST(PerceptionScores, APerfectResultScoresOne) {
   const RgbdFrame f = labelled_wall();
   perception::PerceptionResult r = result_of(f, perfect);
   r.centroid = Eigen::Vector3d(0.03, 0.04, 0.5);
-  const perception::PerceptionScores s = score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
   EXPECT_EQ(s.object_cells, 10u * 29u);
   EXPECT_EQ(s.occluder_cells, 10u * 29u);
   EXPECT_DOUBLE_EQ(*s.object_precision, 1.0);
@@ -130,7 +130,7 @@ TEST(PerceptionScores, CountsTheVoxelsGivenToTheWrongClass) {
     if (u >= 30 && u < 35) return perception::SupervoxelClass::Occluder;
     return perfect(u);
   });
-  const perception::PerceptionScores s = score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
   // Object: columns 10-17 right, 20 wrong: 8 of 9; found 8 of 10 columns.
   EXPECT_NEAR(*s.object_precision, 8.0 / 9.0, 1e-12);
   // Recall finds a cell within one voxel edge of an object voxel: pixels are
@@ -149,7 +149,7 @@ TEST(PerceptionScores, OccluderRecallCountsOnlyTheSphere) {
   });
   // A sphere around column 21's centre (x = 0.0125 m) reaching columns 20-22 only (< 2 px).
   const Eigen::Vector3d centre(point(f, 21, 15).cast<double>());
-  const perception::PerceptionScores s = score_perception(f, r, truth_at(centre, 0.02), every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, truth_at(centre, 0.02), every_pixel());
   // In the sphere: columns 20-22 of rows 14-16 (+-1 px, 12.5 mm < 20 mm) plus
   // the 4 diagonal ones out (17.7 mm < 20 mm: in): a 3 x 3 block.
   EXPECT_EQ(s.occluder_cells, 9u);
@@ -161,7 +161,7 @@ TEST(PerceptionScores, ALostObjectHasNoPrecisionAndNoRecall) {
   const RgbdFrame f = labelled_wall();
   perception::PerceptionResult r = result_of(f, perfect);
   r.status = perception::TrackingStatus::Lost;
-  const perception::PerceptionScores s = score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
   EXPECT_FALSE(s.object_precision);
   EXPECT_DOUBLE_EQ(*s.object_recall, 0.0);
   EXPECT_FALSE(s.centroid_error);
@@ -171,7 +171,7 @@ TEST(PerceptionScores, NoOccluderInTheSphereGivesNoOccluderRecall) {
   RgbdFrame f = labelled_wall();
   for (std::uint16_t& label : f.labels) label = label == kPixelOccluder0 ? std::uint16_t{kPixelSupport} : label;
   const perception::PerceptionResult r = result_of(f, [](int u) { return u >= 10 && u < 20 ? perception::SupervoxelClass::Object : perception::SupervoxelClass::Background; });
-  const perception::PerceptionScores s = score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, truth_at(Eigen::Vector3d(0.0, 0.0, 0.5)), every_pixel());
   EXPECT_EQ(s.occluder_cells, 0u);
   EXPECT_FALSE(s.occluder_recall);
   EXPECT_FALSE(s.occluder_precision);  // nothing called occluder
@@ -180,7 +180,7 @@ TEST(PerceptionScores, NoOccluderInTheSphereGivesNoOccluderRecall) {
 TEST(PerceptionScores, WithoutTheTrueCentroidThereIsNoOccluderRecallNorCentroidError) {
   const RgbdFrame f = labelled_wall();
   const perception::PerceptionResult r = result_of(f, perfect);
-  const perception::PerceptionScores s = score_perception(f, r, perception::PerceptionTruth{}, every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, perception::PerceptionTruth{}, every_pixel());
   EXPECT_DOUBLE_EQ(*s.object_precision, 1.0);
   EXPECT_DOUBLE_EQ(*s.object_recall, 1.0);
   EXPECT_DOUBLE_EQ(*s.occluder_precision, 1.0);
@@ -197,7 +197,7 @@ TEST(PerceptionScores, HiddenErrorIsTheDistanceToTheTrueSurface) {
     for (int j = -50; j <= 50; ++j) t.surface.emplace_back(0.002 * i, 0.002 * j, 0.6);
   }
   r.hidden = {Eigen::Vector3f(0.01f, 0.02f, 0.59f), Eigen::Vector3f(-0.03f, 0.0f, 0.57f)};
-  const perception::PerceptionScores s = score_perception(f, r, t, every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, t, every_pixel());
   EXPECT_EQ(s.hidden_voxels, 2u);
   EXPECT_NEAR(*s.hidden_error, 0.02, 1e-6);
 }
@@ -211,7 +211,7 @@ TEST(PerceptionScores, IsTheSameFromAnyCameraPose) {
   perception::PerceptionResult r = result_of(f, perfect);
   for (Eigen::Vector3f& p : r.voxels) p = (f.wMc.cast<float>() * p);
   const Eigen::Vector3d centre = f.wMc * Eigen::Vector3d(0.0, 0.0, 0.5);
-  const perception::PerceptionScores s = score_perception(f, r, truth_at(centre), every_pixel());
+  const perception::PerceptionScores s = perception::score_perception(f, r, truth_at(centre), every_pixel());
   EXPECT_DOUBLE_EQ(*s.object_precision, 1.0);
   EXPECT_DOUBLE_EQ(*s.object_recall, 1.0);
   EXPECT_DOUBLE_EQ(*s.occluder_precision, 1.0);

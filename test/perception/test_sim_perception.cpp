@@ -252,7 +252,7 @@ TEST(SimPerception, LabelsModeIsAPerfectClassifierOfTheFrame) {
     EXPECT_LT((*truth.centroid - renderer.truth(scenario.wMc_start, settings.r_sphere).centroid).norm(), 1e-12);
     truth.r_sphere = settings.r_sphere;
     truth.surface = renderer.object_surface();
-    const perception::PerceptionScores s = score_perception(rendered.frame, r, truth, settings);
+    const perception::PerceptionScores s = perception::score_perception(rendered.frame, r, truth, settings);
     EXPECT_DOUBLE_EQ(*s.object_precision, 1.0) << "frame " << k;
     EXPECT_GE(*s.object_recall, 0.98) << "frame " << k;
     if (s.occluder_precision) {

@@ -30,23 +30,23 @@ vpHomogeneousMatrix looking_at(const Eigen::Vector3d& p, const Eigen::Vector3d& 
   Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
   m.linear() << y.cross(z), y, z;
   m.translation() = p;
-  return to_visp(m);
+  return servo::to_visp(m);
 }
 
 TEST(TargetPose, LooksAtTheCentroidWithTheLeastRotation) {
   const Eigen::Vector3d c(0.1, -0.2, 1.0), t(0.4, -0.1, 0.6);
   const vpHomogeneousMatrix wMc = looking_at({0, 0, 0}, c);
-  const Eigen::Isometry3d wMcd = to_eigen(target_pose(t, c, wMc));
+  const Eigen::Isometry3d wMcd = servo::to_eigen(servo::target_pose(t, c, wMc));
   EXPECT_TRUE(wMcd.translation().isApprox(t));
   EXPECT_TRUE(wMcd.linear().col(2).isApprox((c - t).normalized(), 1e-12));
   // The rotation between the two orientations is the angle between their Z axes.
-  const Eigen::Matrix3d cRcd = to_eigen(wMc).linear().transpose() * wMcd.linear();
+  const Eigen::Matrix3d cRcd = servo::to_eigen(wMc).linear().transpose() * wMcd.linear();
   const double angle = Eigen::AngleAxisd(cRcd).angle();
-  EXPECT_NEAR(angle, std::acos(to_eigen(wMc).linear().col(2).dot(wMcd.linear().col(2))), 1e-9);
+  EXPECT_NEAR(angle, std::acos(servo::to_eigen(wMc).linear().col(2).dot(wMcd.linear().col(2))), 1e-9);
   // Already looking at C: the orientation is kept exactly.
-  const vpHomogeneousMatrix same = target_pose(Eigen::Vector3d(0, 0, 0), c, wMc);
-  EXPECT_TRUE(to_eigen(same).linear().isApprox(to_eigen(wMc).linear(), 1e-12));
-  EXPECT_THROW((void)target_pose(c, c, wMc), std::invalid_argument);
+  const vpHomogeneousMatrix same = servo::target_pose(Eigen::Vector3d(0, 0, 0), c, wMc);
+  EXPECT_TRUE(servo::to_eigen(same).linear().isApprox(servo::to_eigen(wMc).linear(), 1e-12));
+  EXPECT_THROW((void)servo::target_pose(c, c, wMc), std::invalid_argument);
 }
 
 // s after the camera moves by twist v for a time h.
@@ -100,11 +100,11 @@ std::pair<double, double> servo_to(servo::ControllerSettings::Law law, double* f
   for (int k = 0; k < 150; ++k) {
     const vpColVector v = controller.update(tf, c, r, camera.wMc(), 1.0 / 30);
     camera.step(v, 1.0 / 30);
-    const double dist = (to_eigen(camera.wMc()).translation() - c).norm();
+    const double dist = (servo::to_eigen(camera.wMc()).translation() - c).norm();
     worst = std::max(worst, std::abs(dist - r));
     nearest = std::min(nearest, dist);
   }
-  if (final_error) *final_error = (to_eigen(camera.wMc()).translation() - tf).norm();
+  if (final_error) *final_error = (servo::to_eigen(camera.wMc()).translation() - tf).norm();
   return {worst, nearest};
 }
 
@@ -139,17 +139,17 @@ TEST(Robots, FollowAConstantTwist) {
   const vpColVector v{0.05, -0.02, 0.03, 0.1, -0.05, 0.08};
   for (const servo::RobotKind kind : {servo::RobotKind::Camera, servo::RobotKind::Viper850, servo::RobotKind::Afma6}) {
     const std::string name = to_string(kind);
-    EXPECT_EQ(parse_robot_kind(name), kind);
-    auto robot = make_robot(kind, start);
-    EXPECT_TRUE(to_eigen(robot->wMc()).isApprox(to_eigen(start), 1e-9)) << name;
+    EXPECT_EQ(servo::parse_robot_kind(name), kind);
+    auto robot = servo::make_robot(kind, start);
+    EXPECT_TRUE(servo::to_eigen(robot->wMc()).isApprox(servo::to_eigen(start), 1e-9)) << name;
     const double dt = 0.01;
     const servo::RobotStep step = robot->step(v, dt);
-    const Eigen::Isometry3d expected = to_eigen(start * vpExponentialMap::direct(v, dt));
-    EXPECT_LT((to_eigen(step.wMc).translation() - expected.translation()).norm(), 1e-5) << name;
-    EXPECT_LT(Eigen::AngleAxisd(to_eigen(step.wMc).linear().transpose() * expected.linear()).angle(), 1e-4) << name;
+    const Eigen::Isometry3d expected = servo::to_eigen(start * vpExponentialMap::direct(v, dt));
+    EXPECT_LT((servo::to_eigen(step.wMc).translation() - expected.translation()).norm(), 1e-5) << name;
+    EXPECT_LT(Eigen::AngleAxisd(servo::to_eigen(step.wMc).linear().transpose() * expected.linear()).angle(), 1e-4) << name;
     EXPECT_FALSE(step.limited) << name;
   }
-  EXPECT_THROW((void)parse_robot_kind("puma560"), std::invalid_argument);
+  EXPECT_THROW((void)servo::parse_robot_kind("puma560"), std::invalid_argument);
 }
 
 // ViSP's threaded simulator, driven in wall-clock time, against its
@@ -160,7 +160,7 @@ TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
   for (const auto model : {servo::KinematicArm::Model::Viper850, servo::KinematicArm::Model::Afma6}) {
     servo::ThreadedArm threaded(model, start);
     servo::KinematicArm twin(model, start);
-    EXPECT_TRUE(to_eigen(threaded.wMc()).isApprox(to_eigen(start), 1e-6)) << threaded.name();
+    EXPECT_TRUE(servo::to_eigen(threaded.wMc()).isApprox(servo::to_eigen(start), 1e-6)) << threaded.name();
     const vpColVector v{0.04, 0.0, 0.02, 0.0, 0.3, 0.15};
     const double dt = 1.0 / 30.0;
     const auto t0 = std::chrono::steady_clock::now();
@@ -170,13 +170,13 @@ TEST(Robots, ThreadedArmFollowsItsKinematicTwinInWallClockTime) {
     }
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_GE(elapsed, 15 * dt - 0.02) << "one period of wall-clock time per step";
-    const Eigen::Isometry3d a = to_eigen(threaded.wMc()), b = to_eigen(twin.wMc());
+    const Eigen::Isometry3d a = servo::to_eigen(threaded.wMc()), b = servo::to_eigen(twin.wMc());
     EXPECT_LT((a.translation() - b.translation()).norm(), 0.015) << threaded.name();
     EXPECT_LT(Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle(), 3.0 * kPi / 180.0) << threaded.name();
-    EXPECT_GT(Eigen::AngleAxisd(to_eigen(start).linear().transpose() * b.linear()).angle(), 5.0 * kPi / 180.0)
+    EXPECT_GT(Eigen::AngleAxisd(servo::to_eigen(start).linear().transpose() * b.linear()).angle(), 5.0 * kPi / 180.0)
         << "the twin should have turned";
   }
-  EXPECT_THROW((void)make_robot(servo::RobotKind::Camera, start, /*real_time=*/true), std::invalid_argument);
+  EXPECT_THROW((void)servo::make_robot(servo::RobotKind::Camera, start, /*real_time=*/true), std::invalid_argument);
 }
 
 // Driven into a joint limit and then held still, the threaded arm stops
@@ -204,7 +204,7 @@ TEST(Robots, ThreadedArmStopsShortOfItsJointLimits) {
     double nearest = 1e9;
     for (unsigned i = 0; i < 6; ++i) nearest = std::min({nearest, q[i] - lo[i], hi[i] - q[i]});
     EXPECT_LT(nearest, 0.1) << arm.name() << ": the twist should have brought a joint near its limit";
-    EXPECT_TRUE(to_eigen(arm.wMc()).matrix().allFinite()) << arm.name();
+    EXPECT_TRUE(servo::to_eigen(arm.wMc()).matrix().allFinite()) << arm.name();
   }
 }
 
@@ -232,9 +232,9 @@ TEST(Robots, ArmsStayBoundedAtASingularity) {
   const double dt = 1.0 / 30.0;
   for (int k = 0; k < 30; ++k) {
     const vpColVector before = arm.joints();
-    const Eigen::Vector3d p0 = to_eigen(arm.wMc()).translation();
+    const Eigen::Vector3d p0 = servo::to_eigen(arm.wMc()).translation();
     (void)arm.step(v, dt);
-    EXPECT_LE((to_eigen(arm.wMc()).translation() - p0).norm(), 1.05 * std::hypot(0.3, 0.2) * dt + 1e-3) << "step " << k;
+    EXPECT_LE((servo::to_eigen(arm.wMc()).translation() - p0).norm(), 1.05 * std::hypot(0.3, 0.2) * dt + 1e-3) << "step " << k;
     for (unsigned i = 0; i < 6; ++i) EXPECT_LE(std::abs(arm.joints()[i] - before[i]), 2.5 * dt + 1e-12) << "joint " << i;
   }
 }
@@ -253,7 +253,7 @@ TEST(Robots, ADriverPoseThatIsNotFiniteIsAnError) {
         return fMc;
       },
       vpHomogeneousMatrix(), "test-arm");
-  EXPECT_TRUE(to_eigen(robot.wMc()).matrix().allFinite());
+  EXPECT_TRUE(servo::to_eigen(robot.wMc()).matrix().allFinite());
   faulty = true;
   try {
     (void)robot.wMc();

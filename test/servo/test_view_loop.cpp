@@ -32,7 +32,7 @@ ViewProblem patch(bool occluded) {
 Observation observed(std::optional<ViewProblem> problem, const vpHomogeneousMatrix& wMc, double age,
                      std::optional<double> shown = std::nullopt, Eigen::Index presumed = 0) {
   Observation o;
-  o.wMc = to_eigen(wMc);
+  o.wMc = servo::to_eigen(wMc);
   o.age = age;
   o.shown_area = shown;
   if (problem) {
@@ -49,7 +49,7 @@ Observation observed(std::optional<ViewProblem> problem, const vpHomogeneousMatr
 class Fixed : public Observer {
  public:
   explicit Fixed(std::optional<ViewProblem> problem) : problem_(std::move(problem)) {}
-  Observation observe(const RgbdFrame& frame) override { return observed(problem_, to_visp(frame.wMc), 0.0); }
+  Observation observe(const RgbdFrame& frame) override { return observed(problem_, servo::to_visp(frame.wMc), 0.0); }
 
  private:
   std::optional<ViewProblem> problem_;
@@ -398,16 +398,16 @@ TEST(ViewLoop, ItDoesNotGoWhereItsOwnMotionWouldHideTheObject) {
 
 TEST(ViewLoop, SettingsByNameAreValidated) {
   servo::LoopSettings s;
-  loop_settings_table().set(s, "max_linear_speed", "0.3");
+  servo::loop_settings_table().set(s, "max_linear_speed", "0.3");
   EXPECT_EQ(s.controller.max_linear_speed, 0.3);
   EXPECT_EQ(s.safety.max_linear_speed, 0.3);  // one setting, both limits
-  loop_settings_table().set(s, "workspace", "-1,-1,0,1,1,2");
+  servo::loop_settings_table().set(s, "workspace", "-1,-1,0,1,1,2");
   EXPECT_TRUE(s.safety.workspace.contains(Eigen::Vector3d(0, 0, 1)));
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
            {"max_linear_speed", "inf"}, {"max_linear_speed", "1e9"}, {"gain", "0"}, {"method", "nbv"},
            {"workspace", "1,1,1,0,0,0"}, {"workspace", "1,2,3"}, {"stale_timeout", "-1"}}) {
     try {
-      loop_settings_table().set(s, name, value);
+      servo::loop_settings_table().set(s, name, value);
       ADD_FAILURE() << name << "=" << value << " accepted";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
@@ -438,7 +438,7 @@ TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
   servo::RobotLoopOptions options;
   Fixed observer(patch(true));
   std::vector<servo::SafetyAction> actions;
-  const servo::RobotLoopSummary summary = run_on_robot(source, observer, robot, servo::LoopSettings{}, options, [&](const servo::RobotLoopFrame& f) {
+  const servo::RobotLoopSummary summary = servo::run_on_robot(source, observer, robot, servo::LoopSettings{}, options, [&](const servo::RobotLoopFrame& f) {
     actions.push_back(f.step->safety);
     ASSERT_NE(f.observation, nullptr);
     EXPECT_DOUBLE_EQ(f.observation->age, f.frame_age);
@@ -458,12 +458,12 @@ TEST(RobotLoop, TheStopFlagEndsTheRunAndMaxDurationTheSource) {
   servo::RobotLoopOptions options;
   Fixed observer(patch(false));
   options.stop = &stop;
-  servo::RobotLoopSummary summary = run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
+  servo::RobotLoopSummary summary = servo::run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 0);
   EXPECT_TRUE(summary.stopped);
   stop = 0;
   options.max_duration = 0.15;
-  summary = run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
+  summary = servo::run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 2);  // 0 and 0.1 s; the frame at 0.2 s is past the duration
   EXPECT_FALSE(summary.stopped);
 }

@@ -26,11 +26,11 @@ SettingsTable<EpisodeSetup> make_table() {
   using E = EpisodeSetup;
   const EpisodeSetup d;
   SettingsTable<E> t;
-  t.include(loop_settings_table(), [](auto& e) -> auto& { return e.loop; });
-  t.include(perception_settings_table(), [](auto& e) -> auto& { return e.front_end; });
+  t.include(servo::loop_settings_table(), [](auto& e) -> auto& { return e.loop; });
+  t.include(perception::perception_settings_table(), [](auto& e) -> auto& { return e.front_end; });
   t.add({"robot", "camera | viper850 | afma6", "the scenario's", "",
          "free-flying camera, or the arm on ViSP's kinematic model (threaded simulator with real_time)"},
-        [](E& e, const std::string& v) { e.robot = parse_robot_kind(v); },
+        [](E& e, const std::string& v) { e.robot = servo::parse_robot_kind(v); },
         [](const E& e) { return std::string(to_string(e.robot)); });
   t.add({"perception", "full | labels | ground-truth", to_string(d.perception), "",
          "the front end on the frames; the same with the rendered labels in place of segmentation and classification "
@@ -103,7 +103,7 @@ perception::PerceptionScores score(const RgbdFrame& frame, const perception::Per
   truth.centroid = frame.object_centroid;
   truth.r_sphere = settings.r_sphere;
   truth.surface = renderer.object_surface();
-  return score_perception(frame, result, truth, settings);
+  return perception::score_perception(frame, result, truth, settings);
 }
 
 // Ground truth as the loop sees it: the simulator's problem (every occluder
@@ -113,7 +113,7 @@ Observation truth_observation(const RgbdFrame& frame, ViewProblem problem, const
   Observation o;
   o.wMc = frame.wMc;
   o.problem = std::move(problem);
-  o.shown_area = labelled_shown_area(frame, settings);
+  o.shown_area = perception::labelled_shown_area(frame, settings);
   return o;
 }
 
@@ -180,7 +180,7 @@ long episode_frames(const EpisodeSetup& setup) {
 }  // namespace
 
 perception::PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
-  perception::PerceptionSettings settings = perception_settings(setup.loop.estimator.resolve(), setup.front_end);
+  perception::PerceptionSettings settings = perception::perception_settings(setup.loop.estimator.resolve(), setup.front_end);
   if (setup.perception == PerceptionMode::Labels) settings.classes = perception::PerceptionSettings::Classes::Labels;
   return settings;
 }
@@ -204,7 +204,7 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
                              const std::vector<std::pair<std::string, std::string>>& settings) {
   EpisodeSetup s;
   s.loop.estimator = scenario.estimator;
-  s.robot = parse_robot_kind(scenario.robot);
+  s.robot = servo::parse_robot_kind(scenario.robot);
   s.duration = scenario.duration;
   // The scenario's controller section (`law` is the setting `controller`), then the settings.
   for (const auto& [k, v] : scenario.controller) episode_settings_table().set(s, k == "law" ? "controller" : k, v);
@@ -234,7 +234,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
 
   servo::ViewLoop loop(setup.loop);
   sim::Renderer renderer(scenario);
-  std::unique_ptr<servo::CameraRobot> robot = make_robot(setup.robot, to_visp(scenario.wMc_start), setup.real_time);
+  std::unique_ptr<servo::CameraRobot> robot = servo::make_robot(setup.robot, servo::to_visp(scenario.wMc_start), setup.real_time);
   const perception::PerceptionSettings front_end = front_end_settings(setup);
   std::optional<perception::PerceptionObserver> perception;  // full, labels: made on the first frame, which may point out the object
 
@@ -247,7 +247,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     StepRecord rec;
     rec.time = static_cast<double>(k) * dt;
     const vpHomogeneousMatrix wMc_visp = robot->wMc();
-    const Eigen::Isometry3d wMc = to_eigen(wMc_visp);
+    const Eigen::Isometry3d wMc = servo::to_eigen(wMc_visp);
     rec.wMc = wMc;
 
     auto start = Clock::now();
@@ -299,8 +299,8 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
   (void)episode_frames(setup);
   const EstimatorSettings estimator = setup.loop.estimator.resolve();
   sim::Renderer renderer(setup.scenario);
-  std::unique_ptr<servo::CameraRobot> robot = make_robot(setup.robot, to_visp(setup.scenario.wMc_start), /*real_time=*/true);
-  sim::LiveSource source(renderer, [&robot] { return to_eigen(robot->wMc()); }, setup.duration);
+  std::unique_ptr<servo::CameraRobot> robot = servo::make_robot(setup.robot, servo::to_visp(setup.scenario.wMc_start), /*real_time=*/true);
+  sim::LiveSource source(renderer, [&robot] { return servo::to_eigen(robot->wMc()); }, setup.duration);
 
   servo::RobotLoopOptions options;
   options.wall_clock_age = true;
@@ -312,7 +312,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     sim::RenderedFrame first;
     const sim::SensorSettings& sensor = renderer.scenario().sensor;
     renderer.set_time(0.0);
-    renderer.render(to_eigen(robot->wMc()), 0, sensor.intrinsics, sensor.noise.enabled, first);
+    renderer.render(servo::to_eigen(robot->wMc()), 0, sensor.intrinsics, sensor.noise.enabled, first);
     front_end.selection = object_in(first.frame.labels);
   }
   TruthObserver truth(renderer, estimator, front_end);
@@ -321,7 +321,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
   Observer& observer_of_frames = perception ? static_cast<Observer&>(*perception) : truth;
 
   EpisodeOutcome outcome;
-  (void)run_on_robot(source, observer_of_frames, *robot, setup.loop, options, [&](const servo::RobotLoopFrame& f) {
+  (void)servo::run_on_robot(source, observer_of_frames, *robot, setup.loop, options, [&](const servo::RobotLoopFrame& f) {
     StepRecord rec;
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;

@@ -219,7 +219,7 @@ class ViewLoop {
    */
   [[nodiscard]] LoopStep step(const Observation& observation, double dt);
 
-  /// \brief Forgets the previous view, target and command (a new run).
+  /// \brief Forgets all it learnt: previous view and target, command, occluder tracks, mode (a new run).
   void reset();
 
   /// \brief The settings it was made with.
