@@ -1,5 +1,6 @@
 // End to end through the real `ofv` binary.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
@@ -162,6 +163,17 @@ TEST_F(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
       {"estimate " + write("key.json", "{" + sv + ", \"" + std::string(20000, 'k') + "\": 1}").string(), {"key.json", "unknown key"}},
       {"estimate " + [&] { const fs::path p = write("huge.json", "{}"); fs::resize_file(p, (std::uintmax_t{64} << 20) + 1); return p.string(); }(),
        {"huge.json", "bytes"}},
+      // What is not a regular file is refused before it is opened or read:
+      // a directory, a device that never ends, a FIFO without a writer
+      // (which would block), for every command that reads an input file.
+      {"estimate " + dir_.string(), {dir_.string(), "is a directory", "scene"}},
+      {"estimate /dev/zero", {"/dev/zero", "not a regular file"}},
+      {"estimate " + [&] { const fs::path p = dir_ / "scene.fifo"; ::mkfifo(p.c_str(), 0600); return p.string(); }(),
+       {"scene.fifo", "not a regular file"}},
+      {"simulate " + dir_.string(), {dir_.string(), "is a directory", "scenario"}},
+      {"simulate /dev/zero", {"/dev/zero", "not a regular file", "scenario"}},
+      {"compare --scenarios " + std::string(OFV_SOURCE_DIR) + "/sim/scenarios --grid /dev/zero --out " + (dir_ / "sweep").string(),
+       {"/dev/zero", "grid"}},
   };
   for (const auto& c : cases) {
     const CommandResult r = ofv(c.args);

@@ -6,6 +6,7 @@
 #include "ofv/servo/robot_loop.h"
 #include "ofv/servo/target_pose.h"
 #include "ofv/sources/open_source.h"
+#include "ofv/text_file.h"
 #if defined(OFV_HAVE_DISPLAY)
 #include "ofv/display/live_display.h"
 #endif
@@ -28,6 +29,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
 namespace ofv::cli {
 
@@ -39,8 +41,7 @@ void on_signal(int) { g_stop = 1; }
 // The camera-to-end-effector transform from a file of six numbers:
 // tx ty tz [m] thetaux thetauy thetauz [rad] (ViSP's vpPoseVector of eMc).
 vpHomogeneousMatrix read_eMc(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot read the eMc file");
+  std::istringstream in(read_text_file(path, 4096, "eMc"));
   double p[6];
   for (double& x : p) {
     if (!(in >> x) || !std::isfinite(x)) {

@@ -1,5 +1,6 @@
 // Scenario YAML (docs/scenarios.md), motion and built-in scenarios.
 #include "ofv/sim/scenario.h"
+#include "ofv/text_file.h"
 #include "ofv/constants.h"
 
 #include "ofv/io/scene_json.h"
@@ -514,15 +515,7 @@ Scenario load_scenario(const std::string& path_or_name) {
     }
     path = builtin;
   }
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path.string() + ": cannot read file");
-  std::error_code ec;
-  if (fs::file_size(path, ec) > kMaxFileBytes && !ec) {
-    throw std::invalid_argument(path.string() + ": larger than " + std::to_string(kMaxFileBytes) + " bytes");
-  }
-  std::stringstream text;
-  text << in.rdbuf();
-  return scenario_from_yaml(text.str(), path.string());
+  return scenario_from_yaml(read_text_file(path.string(), kMaxFileBytes, "scenario"), path.string());
 }
 
 }  // namespace ofv::sim

@@ -1,5 +1,6 @@
 // Scene and result JSON (ESTIMATOR-SPEC.md §8).
 #include "ofv/io/scene_json.h"
+#include "ofv/text_file.h"
 
 #include "ofv/estimator_settings.h"
 
@@ -235,18 +236,7 @@ Scene scene_from_json(const json& j, const std::string& source) {
 }
 
 Scene read_scene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw std::invalid_argument(path + ": cannot read file (" + std::strerror(errno) + ")");
-  }
-  std::error_code ec;
-  const auto bytes = std::filesystem::file_size(path, ec);
-  if (!ec && bytes > kMaxSceneBytes) {
-    throw std::invalid_argument(path + ": " + std::to_string(bytes) + " bytes, more than " +
-                                std::to_string(kMaxSceneBytes));
-  }
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  return scene_from_text(text, path);
+  return scene_from_text(read_text_file(path, kMaxSceneBytes, "scene"), path);
 }
 
 Scene scene_from_text(const std::string& text, const std::string& source) {

@@ -1,5 +1,6 @@
 // Pose and intrinsics text files of the recorded-sequence formats.
 #include "ofv/sources/sequence_files.h"
+#include "ofv/text_file.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,13 @@
 namespace ofv {
 
 namespace {
+// A recording's list, pose or intrinsics file: one line per frame, a few
+// MB for hours of frames.
+std::string read_list_file(const std::string& path, const std::string& what) {
+  constexpr std::uintmax_t kMaxListBytes = 256 << 20;
+  return read_text_file(path, kMaxListBytes, what);
+}
+
 // A line of the file as an error message quotes it: at most 80 characters.
 std::string quoted(const std::string& line) {
   return "'" + (line.size() > 80 ? line.substr(0, 80) + "..." : line) + "'";
@@ -31,10 +39,7 @@ void for_each_data_line(std::istream& in, const std::function<void(const std::st
 
 void for_each_data_line(const std::string& path, const std::string& what,
                         const std::function<void(const std::string&, int)>& f) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open the " + what);
-  }
+  std::istringstream in(read_list_file(path, what));
   for_each_data_line(in, f);
 }
 
@@ -68,10 +73,7 @@ std::vector<StampedPose> parse_pose_file(std::istream& in, const std::string& pa
 }
 
 std::vector<StampedPose> read_pose_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open the pose file");
-  }
+  std::istringstream in(read_list_file(path, "pose file"));
   return parse_pose_file(in, path);
 }
 
@@ -146,10 +148,7 @@ CameraIntrinsics parse_intrinsics_file(std::istream& in, const std::string& path
 }
 
 CameraIntrinsics read_intrinsics_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open the intrinsics file");
-  }
+  std::istringstream in(read_list_file(path, "intrinsics file"));
   return parse_intrinsics_file(in, path);
 }
 

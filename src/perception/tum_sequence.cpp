@@ -1,6 +1,7 @@
 // TUM RGB-D layout: reader (PNG through libpng's simplified API, which reports
 // errors in its result rather than on the terminal) and writer (OpenCV).
 #include "ofv/sources/tum_sequence.h"
+#include "ofv/text_file.h"
 
 #include "ofv/perception/cloud.h"
 
@@ -28,10 +29,8 @@ namespace {
 using ListEntry = TimedFile;
 
 std::vector<ListEntry> read_list(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot open the list (not a TUM RGB-D sequence?)");
-  }
+  constexpr std::uintmax_t kMaxListBytes = 256 << 20;  // one line per frame
+  std::istringstream in(read_text_file(path, kMaxListBytes, "TUM RGB-D list"));
   return parse_timestamp_list(in, path);
 }
 

@@ -1,6 +1,7 @@
 // The episode files of `ofv compare`: written one by one (resume), read back
 // from one or several output folders (merge).
 #include "ofv/loop/episode_store.h"
+#include "ofv/text_file.h"
 
 #include "ofv/loop/metrics_json.h"
 #include "ofv/version.h"
@@ -63,11 +64,10 @@ EpisodeSpec spec_from_json(const json& j) {
   return s;
 }
 
+// An episode's record (its JSON, a few kB).
 std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+  constexpr std::uintmax_t kMaxRecordBytes = 64 << 20;
+  return read_text_file(p.string(), kMaxRecordBytes, "episode record");
 }
 
 // `a=1 b=2`, or `none`.

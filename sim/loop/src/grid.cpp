@@ -1,5 +1,6 @@
 // The settings grid of `ofv compare`: YAML to a list of named variants.
 #include "ofv/loop/grid.h"
+#include "ofv/text_file.h"
 
 #include "ofv/sim/yaml_checks.h"
 
@@ -153,11 +154,8 @@ Grid grid_from_yaml(const std::string& text, const std::string& source) {
 }
 
 Grid read_grid(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot read file");
-  std::stringstream s;
-  s << in.rdbuf();
-  return grid_from_yaml(s.str(), path);
+  constexpr std::uintmax_t kMaxGridBytes = 1 << 20;
+  return grid_from_yaml(read_text_file(path, kMaxGridBytes, "grid"), path);
 }
 
 }  // namespace ofv
