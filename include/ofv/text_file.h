@@ -16,7 +16,9 @@ namespace ofv {
  * there; anything but a regular file (a directory, a device such as
  * /dev/zero, a FIFO, a socket) is refused before it is opened, so that
  * nothing blocks on a FIFO without a writer.
- * \param what what the file was expected to be ("scenario", "grid", ...), for the messages.
+ * \param path      the file.
+ * \param max_bytes the longest file accepted [bytes].
+ * \param what      what the file was expected to be ("scenario", "grid", ...), for the messages.
  * \throws std::invalid_argument naming the path and `what`: missing, not a
  *         regular file, unreadable, or longer than `max_bytes`.
  */
