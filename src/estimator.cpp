@@ -36,6 +36,7 @@ constexpr double kFarHemisphereEps = 1e-9;  // §4: d . w <= this has no gnomoni
 constexpr double kZeroPushEps = 1e-12;      // §4: |v| below this
 constexpr double kParallelEps = 1e-9;       // §4: |e1 . w| >= 1 - this
 constexpr double kMinNormal = 1e-12;        // §7: shorter normals are invalid
+constexpr double kAxesOrthogonalEps = 1e-6;  // given axes: |cos| between two of them above this is refused
 
 // ---------------------------------------------------------------------------
 // Inputs and §7: what the estimator may use.
@@ -83,6 +84,18 @@ void check_problem(const ViewProblem& problem) {
       if (!e.allFinite() || !std::isfinite(len) || len <= 0.0) {
         usage_error("axis e" + std::to_string(k + 1) + " must be finite and non-zero, got " +
                     format_value(e));
+      }
+    }
+    // They are a frame (§2 projects on e2, e3 and measures angles from e1):
+    // pairwise orthogonal once normalised, to kAxesOrthogonalEps.
+    const Eigen::Matrix3d e = problem.axes->colwise().normalized();
+    for (int a = 0; a < 3; ++a) {
+      for (int b = a + 1; b < 3; ++b) {
+        const double cos_ab = e.col(a).dot(e.col(b));
+        if (!(std::abs(cos_ab) <= kAxesOrthogonalEps)) {
+          usage_error("axes e" + std::to_string(a + 1) + " and e" + std::to_string(b + 1) +
+                      " must be orthogonal, the cosine of their angle is " + format_value(cos_ab));
+        }
       }
     }
   }

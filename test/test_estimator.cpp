@@ -384,6 +384,18 @@ TEST(Estimator, GivenAxesMustBeFiniteAndNonZero) {
   }
   p.axes = Eigen::Matrix3d::Identity() * 3.0;  // normalised, not an error
   EXPECT_NO_THROW((void)estimate_view(p, EstimatorSettings{}));
+  // Not a frame: refused up front, naming the pair (before, a skewed frame
+  // gave views off the intended symmetry, or an internal error).
+  p.axes = Eigen::Matrix3d::Identity();
+  p.axes->col(2) << 0.0, 0.01, 1.0;
+  try {
+    (void)estimate_view(p, EstimatorSettings{});
+    ADD_FAILURE() << "skewed axes were accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("e2 and e3 must be orthogonal"), std::string::npos) << e.what();
+  }
+  p.axes->col(2) << 0.0, 1e-8, 1.0;  // orthogonal to rounding
+  EXPECT_NO_THROW((void)estimate_view(p, EstimatorSettings{}));
 }
 
 TEST(Estimator, MismatchedPositionsAndNormalsIsAUsageError) {

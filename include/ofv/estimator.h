@@ -138,8 +138,9 @@ struct ViewProblem {
   Eigen::Matrix3Xd occluders;  ///< 3 x B occluder points q_b (may be empty)
   /// C; default: mean of every usable v_n (spec §7), also those at or outside the sphere.
   std::optional<Eigen::Vector3d> centroid;
-  /// Columns e1, e2, e3; default: PCA of the same v_n as C (a supervoxel skipped
-  /// by spec §1 loses its ray, never its part in C or the axes).
+  /// Columns e1, e2, e3, any length > 0, pairwise orthogonal (|cos| <= 1e-6);
+  /// default: PCA of the same v_n as C (a supervoxel skipped by spec §1 loses
+  /// its ray, never its part in C or the axes).
   std::optional<Eigen::Matrix3d> axes;
   std::optional<Eigen::Vector3d> camera;         ///< current camera position (t0's last fallback)
   std::optional<Eigen::Vector3d> previous_view;  ///< previous t_f, used with warm_start
@@ -275,8 +276,8 @@ class OcclusionField {
  * \param settings validated with validate().
  * \param options  diagnostics switches.
  * \throws std::invalid_argument on invalid input, with a message naming the
- *         field and the value: invalid settings, a non-finite or zero-length
- *         given axis, a non-finite optional point, mismatched positions and
+ *         field and the value: invalid settings, a non-finite, zero-length or
+ *         non-orthogonal given axis, a non-finite optional point, mismatched positions and
  *         normals, the camera fallback of t0 (spec §2) reached without a
  *         camera or with the camera at C, or a warm start from a previous
  *         view at C.
