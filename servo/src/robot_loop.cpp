@@ -5,16 +5,132 @@
 
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
 
 namespace ofv::servo {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Every call of the loop to the robot goes through it, one at a time. From
+// its own thread, it sends the robot a zero velocity when the last command
+// moved it and no other came within `timeout` (a source that stalls, a
+// perception that hangs), whatever the loop's thread is blocked in. A
+// command that does not return within `timeout` (a driver stuck in
+// setVelocity) cannot be overridden through the same driver: it is
+// recorded, and the loop ends the run when the command returns.
+class Watchdog {
+ public:
+  Watchdog(CameraRobot& robot, double timeout, bool on) : robot_(robot), timeout_(seconds(timeout)) {
+    if (on) thread_ = std::thread([this] { watch(); });
+  }
+  ~Watchdog() {
+    {
+      const std::lock_guard<std::mutex> lock(state_mutex_);
+      done_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  Watchdog(const Watchdog&) = delete;
+  Watchdog& operator=(const Watchdog&) = delete;
+
+  RobotStep command(const vpColVector& v, double dt) {
+    const std::lock_guard<std::mutex> robot(robot_mutex_);
+    set_busy(true);
+    struct Done {  // also when the driver throws
+      Watchdog& w;
+      bool moving;
+      ~Done() { w.set_busy(false, moving); }
+    } done{*this, v.frobeniusNorm() > 0.0};
+    return robot_.step(v, dt);
+  }
+  [[nodiscard]] vpHomogeneousMatrix pose() {
+    const std::lock_guard<std::mutex> robot(robot_mutex_);
+    return robot_.wMc();
+  }
+  /// A command took longer than the timeout.
+  [[nodiscard]] bool blocked() {
+    const std::lock_guard<std::mutex> lock(state_mutex_);
+    return blocked_;
+  }
+  [[nodiscard]] long stops() {
+    const std::lock_guard<std::mutex> lock(state_mutex_);
+    return stops_;
+  }
+
+ private:
+  static Clock::duration seconds(double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  }
+  void set_busy(bool busy, bool moving = false) {
+    {
+      const std::lock_guard<std::mutex> lock(state_mutex_);
+      busy_ = busy;
+      since_ = Clock::now();
+      if (!busy) moving_ = moving;
+    }
+    wake_.notify_all();
+  }
+  void watch() {
+    std::unique_lock<std::mutex> lock(state_mutex_);
+    while (!done_) {
+      const Clock::time_point due = since_ + timeout_;
+      if (!busy_ && !moving_) {
+        wake_.wait(lock);
+      } else if (Clock::now() < due) {
+        wake_.wait_until(lock, due);
+      } else if (busy_) {
+        blocked_ = true;
+        wake_.wait(lock);  // until the command returns
+      } else {
+        lock.unlock();
+        std::unique_lock<std::mutex> robot(robot_mutex_, std::try_to_lock);
+        if (robot.owns_lock()) {
+          try {
+            (void)robot_.step(vpColVector(6, 0.0), 0.0);
+          } catch (...) {
+            // The loop's next command meets the driver's error.
+          }
+        }
+        lock.lock();
+        if (robot.owns_lock()) {
+          moving_ = false;
+          ++stops_;
+        }
+        // else a command began meanwhile: it resets the clock.
+      }
+    }
+  }
+
+  CameraRobot& robot_;
+  const Clock::duration timeout_;
+  std::mutex robot_mutex_;  // held during every call to the robot
+  std::mutex state_mutex_;  // guards what follows
+  std::condition_variable wake_;
+  Clock::time_point since_ = Clock::now();  // the last command began (busy) or returned
+  bool busy_ = false;                       // a command is in progress
+  bool moving_ = false;                     // the last command was not zero
+  bool blocked_ = false;
+  long stops_ = 0;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+}  // namespace
 
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,
                               const std::function<void(const RobotLoopFrame&)>& on_frame) {
-  using Clock = std::chrono::steady_clock;
   ViewLoop loop(settings);
+  Watchdog watchdog(robot, settings.safety.stale_timeout, options.move_robot && options.watchdog);
   const auto rest = [&] {
-    if (options.move_robot) (void)robot.step(vpColVector(6, 0.0), 0.0);
+    if (options.move_robot) (void)watchdog.command(vpColVector(6, 0.0), 0.0);
   };
 
   RobotLoopSummary summary;
@@ -32,7 +148,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       const bool stamped = std::isfinite(frame->timestamp);
       if (!first_stamp && stamped) first_stamp = frame->timestamp;
       if (stamped && first_stamp && frame->timestamp - *first_stamp > options.max_duration + 1e-9) break;
-      if (options.pose_from_robot) frame->wMc = to_eigen(robot.wMc());
+      if (options.pose_from_robot) frame->wMc = to_eigen(watchdog.pose());
       const double gap = last_stamp ? frame->timestamp - *last_stamp : 0.0;
       const double dt = last_stamp ? gap : options.first_period;
       if (stamped) last_stamp = frame->timestamp;
@@ -52,7 +168,12 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       // A period that is not finite and positive (a timestamp going backwards
       // or NaN) came with a stop: the robot gets no period it cannot integrate.
       out.dt = std::isfinite(dt) && dt > 0.0 ? dt : 0.0;
-      if (options.move_robot) (void)robot.step(step.velocity, out.dt);
+      if (options.move_robot) (void)watchdog.command(step.velocity, out.dt);
+      if (watchdog.blocked()) {
+        throw std::runtime_error(robot.name() + ": a command took longer than stale_timeout (" +
+                                 std::to_string(settings.safety.stale_timeout) +
+                                 " s) to return, and no stop could be sent meanwhile; the run is stopped");
+      }
       ++summary.frames;
       if (on_frame) on_frame(out);
     }
@@ -67,6 +188,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
   }
   summary.stopped = options.stop != nullptr && *options.stop != 0;
   rest();
+  summary.watchdog_stops = watchdog.stops();
   return summary;
 }
 

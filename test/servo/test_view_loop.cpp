@@ -7,6 +7,15 @@
 #include <gtest/gtest.h>
 
 #include <deque>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+#include <cmath>
+#include <chrono>
+#include <limits>
+#include <thread>
+#include <mutex>
+#include <condition_variable>
 
 namespace ofv {
 namespace {
@@ -466,6 +475,127 @@ TEST(RobotLoop, TheStopFlagEndsTheRunAndMaxDurationTheSource) {
   summary = servo::run_on_robot(source, observer, robot, servo::LoopSettings{}, options);
   EXPECT_EQ(summary.frames, 2);  // 0 and 0.1 s; the frame at 0.2 s is past the duration
   EXPECT_FALSE(summary.stopped);
+}
+
+// A source that serves `before` frames at 30 Hz, then blocks `gap` s (a
+// stalled sensor; infinity: until release()), then serves `after` frames.
+class Stalling : public FrameSource {
+ public:
+  Stalling(int before, double gap, int after) : before_(before), after_(after), gap_(gap) {}
+  std::optional<RgbdFrame> next() override {
+    if (served_ == before_) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (std::isinf(gap_)) {
+        released_.wait(lock, [&] { return release_; });
+      } else {
+        released_.wait_for(lock, std::chrono::duration<double>(gap_), [&] { return release_; });
+      }
+      if (release_) return std::nullopt;
+    }
+    if (served_ >= before_ + after_) return std::nullopt;
+    RgbdFrame f;
+    f.timestamp = served_++ / 30.0;
+    return f;
+  }
+  void release() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      release_ = true;
+    }
+    released_.notify_all();
+  }
+  [[nodiscard]] std::string describe() const override { return "stalling"; }
+
+ private:
+  int before_, after_, served_ = 0;
+  double gap_;
+  std::mutex mutex_;
+  std::condition_variable released_;
+  bool release_ = false;
+};
+
+// A free-flying camera that records when each command came and how fast it
+// was, and blocks `block` s in its `block_at`-th command (a stuck driver).
+class Recording : public servo::CameraRobot {
+ public:
+  explicit Recording(int block_at = -1, double block = 0.0) : block_at_(block_at), block_(block) {}
+  [[nodiscard]] vpHomogeneousMatrix wMc() const override { return camera_.wMc(); }
+  servo::RobotStep step(const vpColVector& v, double dt) override {
+    if (calls_++ == block_at_) std::this_thread::sleep_for(std::chrono::duration<double>(block_));
+    const std::lock_guard<std::mutex> lock(mutex_);
+    log_.emplace_back(std::chrono::steady_clock::now(), speed(v));
+    return camera_.step(v, dt);
+  }
+  [[nodiscard]] std::string name() const override { return "recording"; }
+  [[nodiscard]] std::vector<std::pair<std::chrono::steady_clock::time_point, double>> log() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return log_;
+  }
+
+ private:
+  servo::FreeFlyingCamera camera_{vpHomogeneousMatrix()};
+  int calls_ = 0, block_at_;
+  double block_;
+  std::mutex mutex_;
+  std::vector<std::pair<std::chrono::steady_clock::time_point, double>> log_;
+};
+
+servo::LoopSettings watched_settings() {
+  servo::LoopSettings s;
+  s.safety.stale_timeout = 0.2;
+  return s;
+}
+
+TEST(RobotLoop, TheWatchdogStopsTheRobotWhileTheSourceStallsAndTheLoopResumesAfter) {
+  // 10 frames moving the camera, 0.6 s without a frame, 10 more.
+  Stalling source(10, 0.6, 10);
+  Recording robot;
+  Fixed observer(patch(true));
+  servo::RobotLoopOptions options;
+  options.wall_clock_age = true;
+  const servo::RobotLoopSummary summary = servo::run_on_robot(source, observer, robot, watched_settings(), options);
+  EXPECT_EQ(summary.frames, 20);
+  EXPECT_EQ(summary.watchdog_stops, 1);
+  const auto log = robot.log();
+  ASSERT_GT(log.size(), 21U);
+  // The 11th call is the watchdog's: zero, stale_timeout (to 0.1 s) after the 10th.
+  EXPECT_GT(log[9].second, 0.0);
+  EXPECT_EQ(log[10].second, 0.0);
+  const double after = std::chrono::duration<double>(log[10].first - log[9].first).count();
+  EXPECT_GE(after, 0.2);
+  EXPECT_LT(after, 0.35);
+  EXPECT_GT(log[12].second, 0.0);  // the loop commands again with the frames
+  EXPECT_EQ(log.back().second, 0.0);  // and leaves the robot at rest
+}
+
+TEST(RobotLoop, TheWatchdogStopsTheRobotWhenTheSourceBlocksForever) {
+  Stalling source(10, std::numeric_limits<double>::infinity(), 0);
+  Recording robot;
+  Fixed observer(patch(true));
+  std::thread run([&] { (void)servo::run_on_robot(source, observer, robot, watched_settings(), servo::RobotLoopOptions{}); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  const auto log = robot.log();  // while the source still blocks
+  source.release();  // as a signal would end a blocking read
+  run.join();
+  ASSERT_EQ(log.size(), 11U);
+  EXPECT_GT(log[9].second, 0.0);
+  EXPECT_EQ(log[10].second, 0.0);
+}
+
+TEST(RobotLoop, ADriverStuckInACommandEndsTheRunWithTheRobotAtRest) {
+  Stalling source(30, 0.0, 0);
+  Recording robot(/*block_at=*/5, /*block=*/0.5);
+  Fixed observer(patch(true));
+  try {
+    (void)servo::run_on_robot(source, observer, robot, watched_settings(), servo::RobotLoopOptions{});
+    ADD_FAILURE() << "a driver stuck for 0.5 s went unnoticed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("recording: a command took longer than stale_timeout"), std::string::npos)
+        << e.what();
+  }
+  const auto log = robot.log();
+  ASSERT_EQ(log.size(), 7U);  // 6 commands, then the stop
+  EXPECT_EQ(log.back().second, 0.0);
 }
 
 }  // namespace

@@ -30,6 +30,12 @@ struct RobotLoopOptions {
   bool wall_clock_age = false;
   /// Step the robot with each command (false: a dry run that only reports them).
   bool move_robot = true;
+  /// With move_robot: a thread that sends the robot a zero velocity when no
+  /// command came within the safety filter's `stale_timeout` after one that
+  /// moved it (a source or a perception that stalls), and ends the run when
+  /// a command to the robot does not return within it. Every robot call of
+  /// the run then goes through one lock.
+  bool watchdog = true;
   /// Stop after this much source time [s].
   double max_duration = std::numeric_limits<double>::infinity();
   /// Period of the first frame when the source does not say [s].
@@ -55,6 +61,7 @@ struct RobotLoopSummary {
   long frames = 0;       ///< frames read and answered with a command
   long lost = 0;         ///< frames without the object
   bool stopped = false;  ///< ended by the stop flag
+  long watchdog_stops = 0;  ///< zero velocities the watchdog sent between frames
 };
 
 /**
@@ -74,7 +81,8 @@ struct RobotLoopSummary {
  * \param options  how the source and the robot are treated
  * \param on_frame sees every frame after its command is sent; may be empty.
  * \throws std::invalid_argument for invalid settings; whatever the source,
- *         observer or robot throw at run time.
+ *         observer or robot throw at run time; std::runtime_error when a
+ *         command to the robot did not return within `stale_timeout` (watchdog).
  */
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,
