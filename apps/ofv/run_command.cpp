@@ -346,6 +346,10 @@ Command add_run_command(CLI::App& app) {
                                                : lines.reader_gone() ? ", stopped: the output's reader went away"
                                                                      : ", stopped by a signal")
                                             : "")
+                        << (summary.watchdog_stops > 0
+                                ? "; the watchdog stopped the robot " + std::to_string(summary.watchdog_stops) +
+                                      " time(s) while no frame came"
+                                : "")
                         << '\n';
               return kOk;
             } catch (const std::invalid_argument& e) {  // a recorded frame that is not what it claims (after the stop line)
