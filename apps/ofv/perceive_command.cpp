@@ -136,7 +136,11 @@ Command add_perceive_command(CLI::App& app) {
                   });
               std::cerr << "ofv perceive: " << source->describe() << ": " << summary.frames
                         << " frames, " << summary.lost << " lost, front end median "
-                        << summary.median_front_end_ms << " ms\n";
+                        << summary.median_front_end_ms << " ms"
+                        << (summary.bad_frames > 0 ? "; " + std::to_string(summary.bad_frames) +
+                                                         " bad frame(s) skipped, the last: " + summary.last_bad_frame
+                                                   : "")
+                        << '\n';
               if (summary.scored > 0) {
                 const auto show = [](const std::optional<double>& x, double scale = 1.0) {
                   std::ostringstream text;

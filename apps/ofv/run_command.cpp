@@ -20,6 +20,8 @@
 #include <visp3/robot/vpRobotAfma6.h>
 #endif
 
+#include <nlohmann/json.hpp>
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -108,11 +110,12 @@ class CommandLines {
   /// proposer of the target, the confirmed occluder tracks seen in the frame
   /// (id, position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
   void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,
-             const servo::LoopStep* step = nullptr) {
+             const servo::LoopStep* step = nullptr, const std::string& bad_frame = {}) {
     if (!out_ || closed_) return;
     std::fprintf(out_, "{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
     for (unsigned i = 0; i < 6; ++i) std::fprintf(out_, "%s%.17g", i ? ", " : "", v[i]);
     std::fprintf(out_, "], \"safety\": \"%s\", ", safety);
+    if (!bad_frame.empty()) std::fprintf(out_, "\"bad_frame\": %s, ", nlohmann::json(bad_frame).dump().c_str());
     if (step) {
       std::fprintf(out_, "\"mode\": \"%s\", \"guard\": \"%s\", \"proposer\": \"%s\", ", to_string(step->mode),
                    to_string(step->guard), to_string(step->proposer));
@@ -293,7 +296,7 @@ Command add_run_command(CLI::App& app) {
               bool user_quit = false;  // the display's quit, not a signal
               const auto print = [&](const servo::RobotLoopFrame& f) {
                 lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
-                            to_string(f.step->safety), f.step);
+                            to_string(f.step->safety), f.step, f.bad_frame);
 #if defined(OFV_HAVE_DISPLAY)
                 // The user ending the run stops it as SIGTERM does.
                 if (display && !display->observe(f)) {
@@ -346,6 +349,7 @@ Command add_run_command(CLI::App& app) {
                                                : lines.reader_gone() ? ", stopped: the output's reader went away"
                                                                      : ", stopped by a signal")
                                             : "")
+                        << (summary.bad_frames > 0 ? ", " + std::to_string(summary.bad_frames) + " bad frame(s) skipped" : "")
                         << (summary.watchdog_stops > 0
                                 ? "; the watchdog stopped the robot " + std::to_string(summary.watchdog_stops) +
                                       " time(s) while no frame came"

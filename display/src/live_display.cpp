@@ -452,7 +452,7 @@ bool LiveDisplay::observe(const StepRecord& record, const StepDetail& detail) {
 
 bool LiveDisplay::observe(const servo::RobotLoopFrame& f) {
   DisplayInput in;
-  if (f.frame) {
+  if (f.frame && f.bad_frame.empty()) {  // a skipped frame's images may not match its intrinsics
     in.time = f.frame->timestamp;
     in.wMc = f.frame->wMc;
     in.frame = f.frame;

@@ -9,6 +9,7 @@ const char* to_string(StepStatus status) {
     case StepStatus::NotConverged: return "not_converged";
     case StepStatus::NoOccluders: return "no_occluders";
     case StepStatus::ObjectLost: return "object_lost";
+    case StepStatus::BadFrame: return "bad_frame";
   }
   return "?";
 }

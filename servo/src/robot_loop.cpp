@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <deque>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -16,6 +17,8 @@ namespace ofv::servo {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
 
 // Every call of the loop to the robot goes through it, one at a time. From
 // its own thread, it sends the robot a zero velocity when the last command
@@ -134,11 +137,23 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
   };
 
   RobotLoopSummary summary;
+  long watchdog_stops = 0;       // as of the previous frame
+  int bad_in_row = 0;
+  std::deque<Clock::time_point> bad_times;  // of the bad frames of the last minute
   try {
     std::optional<double> first_stamp, last_stamp;
     while (options.stop == nullptr || *options.stop == 0) {
       const auto asked = Clock::now();
-      std::optional<RgbdFrame> frame = source.next();
+      std::optional<RgbdFrame> frame;
+      std::string unusable;  // a frame the source could not read (BadFrame)
+      try {
+        frame = source.next();
+      } catch (const BadFrame& e) {
+        unusable = first_line(e.what());
+        frame.emplace();  // in its place: the previous time, the robot's pose
+        frame->timestamp = last_stamp.value_or(0.0);
+        frame->wMc = to_eigen(watchdog.pose());
+      }
       // A stop requested while the frame was awaited (a signal during a
       // blocking read) wins over the frame: no command after it but the stop.
       if (!frame || (options.stop != nullptr && *options.stop != 0)) break;
@@ -157,7 +172,44 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       out.index = summary.frames;
       out.frame = &*frame;
       out.source_s = std::chrono::duration<double>(arrived - asked).count();
-      Observation observation = observer.observe(*frame);
+      // The robot stopped by the watchdog since: the next command starts from rest.
+      if (watchdog.stops() != watchdog_stops) loop.robot_stopped();
+      watchdog_stops = watchdog.stops();
+      Observation observation;
+      out.bad_frame = unusable;
+      try {
+        if (unusable.empty()) observation = observer.observe(*frame);
+      } catch (const std::invalid_argument& e) {
+        out.bad_frame = first_line(e.what());
+      }
+      if (!out.bad_frame.empty()) {
+        // Skipped with a stop; the loop keeps its state for the next frame.
+        ++summary.bad_frames;
+        bad_times.push_back(arrived);
+        while (arrived - bad_times.front() > std::chrono::minutes(1)) bad_times.pop_front();
+        if (++bad_in_row > options.max_bad_frames_in_row ||
+            static_cast<long>(bad_times.size()) > options.max_bad_frames_per_minute) {
+          throw std::runtime_error(std::to_string(bad_in_row > options.max_bad_frames_in_row ? bad_in_row
+                                                                                             : bad_times.size()) +
+                                   (bad_in_row > options.max_bad_frames_in_row ? " bad frames in a row"
+                                                                               : " bad frames in a minute") +
+                                   ", the last: " + out.bad_frame);
+        }
+        loop.robot_stopped();
+        observation.wMc = to_eigen(watchdog.pose());
+        LoopStep skipped;
+        skipped.status = StepStatus::BadFrame;
+        skipped.safety = SafetyAction::BadFrame;
+        skipped.mode = loop.mode();
+        skipped.velocity = vpColVector(6, 0.0);
+        out.observation = &observation;
+        out.step = &skipped;
+        if (options.move_robot) (void)watchdog.command(skipped.velocity, 0.0);
+        ++summary.frames;
+        if (on_frame) on_frame(out);
+        continue;
+      }
+      bad_in_row = 0;
       observation.wMc = frame->wMc;
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       observation.age = out.frame_age = options.wall_clock_age ? out.perception_s : gap;

@@ -20,13 +20,14 @@ const char* to_string(SafetyAction action) {
     case SafetyAction::InvalidCommand: return "invalid command";
     case SafetyAction::ObjectLost: return "object lost";
     case SafetyAction::StaleFrame: return "stale frame";
+    case SafetyAction::BadFrame: return "bad frame";
   }
   return "?";
 }
 
 bool stops(SafetyAction action) {
   return action == SafetyAction::InvalidCommand || action == SafetyAction::ObjectLost ||
-         action == SafetyAction::StaleFrame;
+         action == SafetyAction::StaleFrame || action == SafetyAction::BadFrame;
 }
 
 void validate(const SafetySettings& s) {

@@ -114,6 +114,8 @@ ViewLoop::~ViewLoop() = default;
 ViewLoop::ViewLoop(ViewLoop&&) noexcept = default;
 ViewLoop& ViewLoop::operator=(ViewLoop&&) noexcept = default;
 LoopStep ViewLoop::step(const Observation& observation, double dt) { return impl_->step(observation, dt); }
+void ViewLoop::robot_stopped() { impl_->safety.reset(); }
+LoopMode ViewLoop::mode() const { return impl_->mode; }
 void ViewLoop::reset() { impl_ = std::make_unique<Impl>(impl_->settings); }
 const LoopSettings& ViewLoop::settings() const { return impl_->settings; }
 const EstimatorSettings& ViewLoop::estimator() const { return impl_->estimator; }

@@ -195,7 +195,7 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
   if (options_.intrinsics) {
     f.intrinsics = *options_.intrinsics;
     if (f.intrinsics.width != w || f.intrinsics.height != h) {
-      throw std::runtime_error(uri_ + ": frames are " + std::to_string(w) + "x" +
+      throw BadFrame(uri_ + ": a frame is " + std::to_string(w) + "x" +
                                std::to_string(h) + ", the given intrinsics " +
                                std::to_string(f.intrinsics.width) + "x" +
                                std::to_string(f.intrinsics.height));
@@ -220,6 +220,11 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
   }
   f.timestamp = t - s.first_timestamp;
   const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  if (depth.getData() == nullptr || depth.getStrideInBytes() < static_cast<int>(w * sizeof(openni::DepthPixel)) ||
+      static_cast<std::size_t>(depth.getDataSize()) < static_cast<std::size_t>(depth.getStrideInBytes()) * h) {
+    throw BadFrame(uri_ + ": a depth frame of " + std::to_string(depth.getDataSize()) + " bytes for " +
+                   std::to_string(w) + "x" + std::to_string(h) + " pixels (a short read)");
+  }
   f.depth.resize(n);
   const auto* bytes = static_cast<const std::uint8_t*>(depth.getData());
   for (int v = 0; v < h; ++v) {

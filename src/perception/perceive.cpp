@@ -3,10 +3,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
 namespace ofv::perception {
+
+namespace {
+constexpr int kMaxBadFramesInRow = 10;
+}  // namespace
 
 PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
                          const EstimatorSettings& settings, long max_frames,
@@ -25,15 +31,35 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
       &PerceiveSummary::occluder_recall, &PerceiveSummary::centroid_error};
   double sum[kScores] = {};
   long count[kScores] = {};
+  int bad_in_row = 0;
   while (max_frames < 0 || summary.frames < max_frames) {
-    std::optional<RgbdFrame> frame = source.next();
-    if (!frame) {
-      break;
-    }
     PerceivedFrame f;
+    // A frame the source cannot read (BadFrame) or the front end refuses is
+    // skipped and counted; a broken recording (the source's
+    // std::invalid_argument) or many bad frames in a row end the run.
+    std::string bad;
+    try {
+      std::optional<RgbdFrame> frame = source.next();
+      if (!frame) break;
+      f.frame = std::move(*frame);
+    } catch (const BadFrame& e) {
+      bad = e.what();
+    }
+    try {
+      if (bad.empty()) f.result = perception.process(f.frame);
+    } catch (const std::invalid_argument& e) {
+      bad = e.what();
+    }
+    if (!bad.empty()) {
+      ++summary.bad_frames;
+      summary.last_bad_frame = bad.substr(0, bad.find('\n'));
+      if (++bad_in_row > kMaxBadFramesInRow) {
+        throw std::runtime_error(std::to_string(bad_in_row) + " bad frames in a row, the last: " + summary.last_bad_frame);
+      }
+      continue;
+    }
+    bad_in_row = 0;
     f.index = summary.frames;
-    f.frame = std::move(*frame);
-    f.result = perception.process(f.frame);
     front_end_ms.push_back(f.result.timings.total);
     if (f.result.status != TrackingStatus::Lost) {
       f.result.problem.previous_view = previous_view;

@@ -75,6 +75,7 @@ enum class Fault {
   PoseJump,    ///< the frame's pose moved by `amount` m along x
   NanPose,     ///< a NaN in the frame's pose
   Throw,       ///< the source throws
+  BadRead,     ///< the source cannot read this frame (ofv::BadFrame) and goes on
   Stop,        ///< the stop flag is raised while the frame is awaited (a signal)
 };
 
@@ -112,6 +113,9 @@ class FaultySource : public FrameSource {
           case Fault::PoseJump: f->wMc.translation().x() += i.amount; break;
           case Fault::NanPose: f->wMc.translation().y() = std::numeric_limits<double>::quiet_NaN(); break;
           case Fault::Throw: throw std::runtime_error("source fault at frame " + std::to_string(k));
+          case Fault::BadRead:
+            delivered_.push_back({std::numeric_limits<double>::quiet_NaN(), fault});
+            throw BadFrame("short read at frame " + std::to_string(k));
           case Fault::Stop: *stop_ = 1; break;
           case Fault::None: break;
         }
@@ -350,18 +354,39 @@ TEST(Faults, PoseJumpsKeepTheLimits) {
   check_invariants(r, limits());
 }
 
-TEST(Faults, APoseThatIsNotFiniteOrFarAwayEndsTheRunWithAStop) {
-  // Perception refuses it (it once reached PCL's octree, which aborted the
-  // process: no stop); the loop stops the robot and reports.
-  for (const Injection& bad : {Injection{8, Fault::NanPose}, Injection{8, Fault::PoseJump, 1e7}}) {
+TEST(Faults, AFrameThatFailsItsChecksIsSkippedWithAStopAndCounted) {
+  // Perception refuses a pose that is not finite or far away (it once
+  // reached PCL's octree, which aborted the process) and a frame without a
+  // depth image: that frame is skipped, the robot stopped for it, and the
+  // run goes on, its next commands starting from rest.
+  for (const Injection& bad :
+       {Injection{8, Fault::NanPose}, Injection{8, Fault::PoseJump, 1e7}, Injection{8, Fault::EmptyDepth},
+        Injection{8, Fault::BadRead}}) {
     FaultPlan plan;
     plan.source = std::vector<Injection>{bad};
     const FaultRun r = replay(plan);
-    ASSERT_TRUE(r.error);
-    EXPECT_NE(r.error->find("wMc"), std::string::npos) << *r.error;
-    EXPECT_EQ(r.commands.size(), 9U);  // 8 frames, then the stop
+    EXPECT_FALSE(r.error) << *r.error;
+    EXPECT_EQ(r.summary.bad_frames, 1);
+    ASSERT_GT(r.statuses.size(), 20U);  // the run went on
+    EXPECT_EQ(r.statuses.at(8), servo::StepStatus::BadFrame);
+    EXPECT_EQ(r.actions.at(8), servo::SafetyAction::BadFrame);
+    EXPECT_TRUE(is_zero(r.commands.at(8).v));
+    EXPECT_FALSE(is_zero(r.commands.at(12).v));
     check_invariants(r, limits());
   }
+}
+
+TEST(Faults, TooManyBadFramesEndTheRunWithAStop) {
+  // More than max_bad_frames_in_row (10) in a row: the run ends, naming the
+  // last reason, the robot at rest.
+  FaultPlan plan;
+  for (long k = 8; k < 30; ++k) plan.source.push_back({k, Fault::EmptyDepth});
+  const FaultRun r = replay(plan);
+  ASSERT_TRUE(r.error);
+  EXPECT_NE(r.error->find("11 bad frames in a row, the last: "), std::string::npos) << *r.error;
+  EXPECT_NE(r.error->find("depth"), std::string::npos) << *r.error;
+  EXPECT_EQ(r.commands.size(), 8U + 10U + 1U);  // 8 frames, 10 skipped with a stop, then the stop
+  check_invariants(r, limits());
 }
 
 TEST(Faults, ASourceThatThrowsLeavesTheRobotAtRest) {
@@ -371,15 +396,6 @@ TEST(Faults, ASourceThatThrowsLeavesTheRobotAtRest) {
   ASSERT_TRUE(r.error);
   EXPECT_EQ(*r.error, "source fault at frame 8");
   EXPECT_EQ(r.commands.size(), 9U);  // 8 frames, then the stop
-  check_invariants(r, limits());
-}
-
-TEST(Faults, AMalformedFrameLeavesTheRobotAtRest) {
-  FaultPlan plan;
-  plan.source = std::vector<Injection>{{8, Fault::EmptyDepth}};
-  const FaultRun r = replay(plan);
-  ASSERT_TRUE(r.error);
-  EXPECT_NE(r.error->find("depth"), std::string::npos) << *r.error;
   check_invariants(r, limits());
 }
 

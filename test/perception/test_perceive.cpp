@@ -67,6 +67,28 @@ std::vector<perception::PerceivedFrame> perceive_all(FrameSource& source, long m
   return seen;
 }
 
+TEST(Perceive, AFrameThatFailsItsChecksIsSkippedAndCountedManyInARowEndTheRun) {
+  std::vector<RgbdFrame> frames = sequence();
+  RgbdFrame short_read = frames[0];
+  short_read.depth.resize(short_read.depth.size() / 2);  // a depth image of the wrong size
+  frames.insert(frames.begin() + 1, short_read);
+  VectorSource source(frames);
+  perception::PerceiveSummary summary;
+  const auto seen = perceive_all(source, -1, &summary);
+  EXPECT_EQ(seen.size(), frames.size() - 1);
+  EXPECT_EQ(summary.frames, static_cast<long>(frames.size()) - 1);
+  EXPECT_EQ(summary.bad_frames, 1);
+  EXPECT_NE(summary.last_bad_frame.find("depth"), std::string::npos) << summary.last_bad_frame;
+  std::vector<RgbdFrame> broken(11, short_read);
+  VectorSource all_bad(broken);
+  try {
+    (void)perceive_all(all_bad, -1);
+    ADD_FAILURE() << "11 bad frames in a row went on";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("11 bad frames in a row"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {
   const auto frames = sequence();
   VectorSource source(frames);

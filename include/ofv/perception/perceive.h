@@ -24,6 +24,7 @@
 
 #include <functional>
 #include <optional>
+#include <string>
 
 namespace ofv::perception {
 
@@ -48,6 +49,11 @@ struct PerceivedFrame {
 struct PerceiveSummary {
   long frames = 0;  ///< frames read and perceived
   long lost = 0;    ///< of those, frames in which the object was lost (no estimate)
+  /// Frames skipped: the source could not read them (ofv::BadFrame) or the
+  /// front end refused them (std::invalid_argument); not in `frames`, not
+  /// given to the observer. More than 10 in a row end the run (std::runtime_error).
+  long bad_frames = 0;
+  std::string last_bad_frame;  ///< why the last skipped frame was skipped
   /// Median of the front end's total time per frame (PerceptionTimings::total)
   /// [ms]: the upper median, element frames / 2 of the sorted times; 0 without frames.
   double median_front_end_ms = 0.0;

@@ -15,8 +15,9 @@ enum class StepStatus {
   NotConverged,  ///< the estimator ran out of iterations: its best visited view
   NoOccluders,   ///< nothing occludes: t0
   ObjectLost,    ///< no object this frame (perception lost it, or no usable supervoxel): the robot stops
+  BadFrame,      ///< the frame failed its checks and was skipped (run_on_robot): the robot stops
 };
-/// \brief The status's word in files: converged, not_converged, no_occluders, object_lost.
+/// \brief The status's word in files: converged, not_converged, no_occluders, object_lost, bad_frame.
 [[nodiscard]] const char* to_string(StepStatus status);
 
 /// \brief What the safety filter did to a command.
@@ -28,6 +29,7 @@ enum class SafetyAction {
   InvalidCommand,     ///< non-finite command or period: stop
   ObjectLost,         ///< no object: stop
   StaleFrame,         ///< the frame is older than stale_timeout: stop
+  BadFrame,           ///< the frame failed its checks and was skipped: stop
 };
 /// \brief The action's words in files ("" for None, "speed limit", "stale frame" ...).
 [[nodiscard]] const char* to_string(SafetyAction action);

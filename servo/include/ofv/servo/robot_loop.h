@@ -16,6 +16,7 @@
 #include <functional>
 #include <limits>
 #include <optional>
+#include <string>
 
 namespace ofv::servo {
 
@@ -40,6 +41,13 @@ struct RobotLoopOptions {
   double max_duration = std::numeric_limits<double>::infinity();
   /// Period of the first frame when the source does not say [s].
   double first_period = 1.0 / 30.0;
+  /// A frame the source cannot read (ofv::BadFrame: a short read) or the
+  /// observer refuses (std::invalid_argument: a depth image of the wrong
+  /// size, a pose that is not a rigid transform, ...) is skipped with a
+  /// stop; the run ends after more than this many in a row ...
+  int max_bad_frames_in_row = 10;
+  /// ... or more than this many in the last 60 s.
+  int max_bad_frames_per_minute = 30;
   /// When set, stop as soon as it reads non-zero (a signal handler's flag).
   const volatile std::sig_atomic_t* stop = nullptr;
 };
@@ -50,6 +58,7 @@ struct RobotLoopFrame {
   const RgbdFrame* frame = nullptr;  ///< the frame as read (its pose the robot's with pose_from_robot)
   const Observation* observation = nullptr;  ///< what the loop was given (its age set)
   const LoopStep* step = nullptr;  ///< what the loop decided and sent
+  std::string bad_frame;  ///< why the frame was skipped (empty: it was not); step->status is then BadFrame
   double dt = 0.0;         ///< period the command is applied for [s] (0 with a timestamp that does not increase)
   double frame_age = 0.0;  ///< [s]
   double source_s = 0.0;      ///< time spent waiting for and reading the frame [s]
@@ -60,6 +69,7 @@ struct RobotLoopFrame {
 struct RobotLoopSummary {
   long frames = 0;       ///< frames read and answered with a command
   long lost = 0;         ///< frames without the object
+  long bad_frames = 0;   ///< frames skipped for failing their checks
   bool stopped = false;  ///< ended by the stop flag
   long watchdog_stops = 0;  ///< zero velocities the watchdog sent between frames
 };
@@ -81,8 +91,10 @@ struct RobotLoopSummary {
  * \param options  how the source and the robot are treated
  * \param on_frame sees every frame after its command is sent; may be empty.
  * \throws std::invalid_argument for invalid settings; whatever the source,
- *         observer or robot throw at run time; std::runtime_error when a
- *         command to the robot did not return within `stale_timeout` (watchdog).
+ *         observer or robot throw at run time but the observer's refusals of
+ *         single frames; std::runtime_error when a command to the robot did
+ *         not return within `stale_timeout` (watchdog), or after too many bad
+ *         frames (naming the last one's reason).
  */
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,

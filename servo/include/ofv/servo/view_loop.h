@@ -219,6 +219,13 @@ class ViewLoop {
    */
   [[nodiscard]] LoopStep step(const Observation& observation, double dt);
 
+  /// \brief The robot was stopped outside the loop (a watchdog, a skipped
+  ///        frame): the next command starts from rest within the
+  ///        acceleration limits.
+  void robot_stopped();
+  /// \brief The mode the last frame left the loop in.
+  [[nodiscard]] LoopMode mode() const;
+
   /// \brief Forgets all it learnt: previous view and target, command, occluder tracks, mode (a new run).
   void reset();
 
