@@ -175,6 +175,26 @@ TEST_F(Compare, ReportsAggregateOverSeeds) {
 }
 
 
+TEST_F(Compare, NamesCannotBreakTheTablesAndTooManyVariantsAreNotPlotted) {
+  // Axis values become variant names: '|' and line breaks stay inside their cell.
+  const Grid grid = grid_from_yaml("name: g\nseeds: 1\naxes:\n  note: [\"a|b\", \"c\\nd\"]\n", "g.yaml");
+  const EpisodeRunner runner = [&](const EpisodeSpec& s) { return synthetic(s); };
+  run_sweep(plan_episodes({{"one", kScenario}}, grid), runner, dir_.string(), {1, false, {}});
+  (void)write_reports(load_episodes({dir_.string()}), dir_.string());
+  const std::string md = slurp(dir_ / "summary.md");
+  EXPECT_NE(md.find("| note=a\\|b | 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| note=c d | 1 |"), std::string::npos) << md;
+  // More variants than a plot can show: the tables, no plots.
+  std::string values;
+  for (std::size_t k = 0; k <= kMaxPlottedVariants; ++k) values += (k ? ", " : "") + std::to_string(k + 1);
+  const fs::path many = dir_ / "many";
+  run_sweep(plan_episodes({{"one", kScenario}}, grid_from_yaml("seeds: 1\naxes:\n  gain: [" + values + "]\n", "m.yaml")),
+            runner, many.string(), {2, false, {}});
+  EXPECT_TRUE(write_reports(load_episodes({many.string()}), many.string()).empty());
+  EXPECT_TRUE(fs::exists(many / "summary.md"));
+  EXPECT_FALSE(fs::exists(many / "plots" / "plots.gp"));
+}
+
 // The episode files, resume and merge: a folder holds one part of one sweep.
 class SweepFiles : public Compare {
  protected:

@@ -90,6 +90,12 @@ bool bar_chart(const EpisodeGroups& grouped, const MetricColumn& column, const s
 std::vector<std::string> write_plots(const std::vector<EpisodeRow>& rows,
                                      const std::string& out_dir) {
   const EpisodeGroups grouped = group_episodes(rows);
+  const std::size_t variants = grouped.variants.size();
+  if (variants > kMaxPlottedVariants) {
+    std::cerr << "ofv compare: " << variants << " variants: no plots (they are drawn for at most "
+              << kMaxPlottedVariants << "); the tables have them all\n";
+    return {};
+  }
   const fs::path plot_dir = fs::path(out_dir) / "plots";
   fs::create_directories(plot_dir);
   std::ostringstream script;

@@ -11,6 +11,25 @@
 
 namespace ofv {
 
+namespace {
+
+// A name as Markdown text on one line and in a table cell: line breaks
+// become spaces, '|' is escaped.
+std::string md_text(const std::string& name) {
+  std::string out;
+  for (const char c : name) {
+    if (c == '\n' || c == '\r') {
+      out += ' ';
+    } else {
+      if (c == '|' || c == '\\') out += '\\';
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -82,7 +101,7 @@ void write_tables(const std::vector<EpisodeRow>& rows, const std::string& out_di
         "camera sees; recovery is the time from visibility falling below 0.9 until it is "
         "back (dips less than 0.2 s apart are one occlusion).\n";
   for (const auto& scenario : grouped.scenarios) {
-    md << "\n## " << scenario << "\n\n| variant | seeds |";
+    md << "\n## " << md_text(scenario) << "\n\n| variant | seeds |";
     for (const auto& c : metric_columns()) md << ' ' << c.label << " |";
     md << "\n|---|---|";
     for (std::size_t k = 0; k < metric_columns().size(); ++k) md << "---|";
@@ -91,7 +110,7 @@ void write_tables(const std::vector<EpisodeRow>& rows, const std::string& out_di
       if (g.scenario != scenario) continue;
       csv << csv_field(g.scenario) << ',' << csv_field(g.variant.name) << ','
           << csv_field(settings_text(g.variant)) << ',' << g.rows.size();
-      md << "| " << g.variant.name << " | " << g.rows.size() << " |";
+      md << "| " << md_text(g.variant.name) << " | " << g.rows.size() << " |";
       for (const auto& c : metric_columns()) {
         const Interval i = g.interval(c);
         csv << ',' << csv_number(i.mean) << ',' << csv_number(i.half_width);
