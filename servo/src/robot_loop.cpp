@@ -24,9 +24,10 @@ std::string first_line(const std::string& text) { return text.substr(0, text.fin
 // its own thread, it sends the robot a zero velocity when the last command
 // moved it and no other came within `timeout` (a source that stalls, a
 // perception that hangs), whatever the loop's thread is blocked in. A
-// command that does not return within `timeout` (a driver stuck in
-// setVelocity) cannot be overridden through the same driver: it is
-// recorded, and the loop ends the run when the command returns.
+// command that does not return within its period plus `timeout` (a driver
+// stuck in setVelocity; ViSP's drivers may keep the cadence by waiting out
+// the period) cannot be overridden through the same driver: it is recorded,
+// and the loop ends the run when the command returns.
 class Watchdog {
  public:
   Watchdog(CameraRobot& robot, double timeout, bool on) : robot_(robot), timeout_(seconds(timeout)) {
@@ -45,7 +46,7 @@ class Watchdog {
 
   RobotStep command(const vpColVector& v, double dt) {
     const std::lock_guard<std::mutex> robot(robot_mutex_);
-    set_busy(true);
+    set_busy(true, false, std::isfinite(dt) && dt > 0.0 ? dt : 0.0);
     struct Done {  // also when the driver throws
       Watchdog& w;
       bool moving;
@@ -71,11 +72,12 @@ class Watchdog {
   static Clock::duration seconds(double s) {
     return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
   }
-  void set_busy(bool busy, bool moving = false) {
+  void set_busy(bool busy, bool moving = false, double period = 0.0) {
     {
       const std::lock_guard<std::mutex> lock(state_mutex_);
       busy_ = busy;
       since_ = Clock::now();
+      period_ = seconds(period);
       if (!busy) moving_ = moving;
     }
     wake_.notify_all();
@@ -83,7 +85,7 @@ class Watchdog {
   void watch() {
     std::unique_lock<std::mutex> lock(state_mutex_);
     while (!done_) {
-      const Clock::time_point due = since_ + timeout_;
+      const Clock::time_point due = since_ + timeout_ + (busy_ ? period_ : Clock::duration::zero());
       if (!busy_ && !moving_) {
         wake_.wait(lock);
       } else if (Clock::now() < due) {
@@ -117,6 +119,7 @@ class Watchdog {
   std::mutex state_mutex_;  // guards what follows
   std::condition_variable wake_;
   Clock::time_point since_ = Clock::now();  // the last command began (busy) or returned
+  Clock::duration period_{};                // of the command in progress
   bool busy_ = false;                       // a command is in progress
   bool moving_ = false;                     // the last command was not zero
   bool blocked_ = false;
@@ -222,7 +225,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       out.dt = std::isfinite(dt) && dt > 0.0 ? dt : 0.0;
       if (options.move_robot) (void)watchdog.command(step.velocity, out.dt);
       if (watchdog.blocked()) {
-        throw std::runtime_error(robot.name() + ": a command took longer than stale_timeout (" +
+        throw std::runtime_error(robot.name() + ": a command took longer than its period plus stale_timeout (" +
                                  std::to_string(settings.safety.stale_timeout) +
                                  " s) to return, and no stop could be sent meanwhile; the run is stopped");
       }

@@ -34,7 +34,8 @@ struct RobotLoopOptions {
   /// With move_robot: a thread that sends the robot a zero velocity when no
   /// command came within the safety filter's `stale_timeout` after one that
   /// moved it (a source or a perception that stalls), and ends the run when
-  /// a command to the robot does not return within it. Every robot call of
+  /// a command to the robot does not return within its period plus that
+  /// timeout (drivers may wait out the period to keep the cadence). Every robot call of
   /// the run then goes through one lock.
   bool watchdog = true;
   /// Stop after this much source time [s].
@@ -93,8 +94,8 @@ struct RobotLoopSummary {
  * \throws std::invalid_argument for invalid settings; whatever the source,
  *         observer or robot throw at run time but the observer's refusals of
  *         single frames; std::runtime_error when a command to the robot did
- *         not return within `stale_timeout` (watchdog), or after too many bad
- *         frames (naming the last one's reason).
+ *         not return within its period plus `stale_timeout` (watchdog), or
+ *         after too many bad frames (naming the last one's reason).
  */
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,
