@@ -174,6 +174,12 @@ TEST_F(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
       {"simulate /dev/zero", {"/dev/zero", "not a regular file", "scenario"}},
       {"compare --scenarios " + std::string(OFV_SOURCE_DIR) + "/sim/scenarios --grid /dev/zero --out " + (dir_ / "sweep").string(),
        {"/dev/zero", "grid"}},
+      // Outputs that would replace or mix with other data: a recording into
+      // a folder that holds something, a .oni beside a device.
+      {"record dvd-static --format tum --out " + [&] { fs::create_directories(dir_ / "used"); write("used/rgb.txt", ""); return (dir_ / "used").string(); }(),
+       {"used", "not empty"}},
+      {"record dvd-static --format pcd --out " + write("afile", "x").string(), {"afile", "not a directory"}},
+      {"record dvd-static --format oni --out /dev/null", {"/dev/null", "not a regular file"}},
   };
   for (const auto& c : cases) {
     const CommandResult r = ofv(c.args);

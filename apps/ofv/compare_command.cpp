@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace ofv::cli {
 
@@ -161,6 +162,13 @@ Command add_compare_command(CLI::App& app) {
             }
             try {
               if (!opt->merge.empty()) {
+                std::optional<MergeTarget> target;
+                try {
+                  target.emplace(opt->out, merged);
+                } catch (const std::invalid_argument& e) {  // another sweep's folder, another merge: nothing written
+                  std::cerr << "ofv compare: " << e.what() << '\n';
+                  return kUsage;
+                }
                 const auto plots = write_reports(merged.rows, opt->out);
                 const fs::path missing_file = fs::path(opt->out) / "missing.csv";
                 std::error_code ignored;

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 
@@ -90,6 +91,12 @@ OniWriter::OniWriter(const std::string& path, int fps) : path_(path), fps_(fps) 
   if (fps <= 0) {
     throw std::invalid_argument("OniWriter " + path + ": fps " + std::to_string(fps) +
                                 ": expected > 0");
+  }
+  // A device or a directory at `path` would get its poses file beside it.
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) {
+    throw std::invalid_argument(path + ": exists and is not a regular file: give a new .oni file");
   }
   out_.open(path, std::ios::binary | std::ios::trunc);
   if (!out_) {

@@ -157,6 +157,7 @@ std::string PcdSequenceSource::describe() const {
 }
 
 PcdSequenceWriter::PcdSequenceWriter(const std::string& directory) : directory_(directory) {
+  refuse_used_directory(directory);
   std::error_code ec;
   fs::create_directories(directory, ec);
   if (!fs::is_directory(directory)) {

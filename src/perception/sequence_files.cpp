@@ -5,11 +5,25 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 namespace ofv {
+
+void refuse_used_directory(const std::string& directory) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(directory, ec)) return;
+  if (!fs::is_directory(directory, ec)) {
+    throw std::invalid_argument(directory + ": exists and is not a directory: give a new directory");
+  }
+  if (!fs::is_empty(directory, ec)) {
+    throw std::invalid_argument(directory + ": not empty (a recording written into it would mix with what is "
+                                "there): give a new or empty directory");
+  }
+}
 
 namespace {
 // A recording's list, pose or intrinsics file: one line per frame, a few

@@ -204,6 +204,7 @@ std::string TumSequenceSource::describe() const {
 
 TumSequenceWriter::TumSequenceWriter(const std::string& directory, double depth_factor)
     : directory_(directory), depth_factor_(depth_factor) {
+  refuse_used_directory(directory);
   std::error_code ec;
   fs::create_directories(fs::path(directory) / "rgb", ec);
   fs::create_directories(fs::path(directory) / "depth", ec);

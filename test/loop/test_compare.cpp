@@ -326,6 +326,33 @@ TEST_F(SweepFiles, MergeRefusesPartsOfDifferentSweeps) {
   }
 }
 
+TEST_F(SweepFiles, MergeWritesOnlyWhereNoOtherSweepOrMergeIs) {
+  run_sweep(plan(), synthetic, (dir_ / "p1").string(), {1, false, {1, 2}});
+  run_sweep(plan(), synthetic, (dir_ / "p2").string(), {1, false, {2, 2}});
+  const SweepEpisodes merged = read_sweep({(dir_ / "p1").string(), (dir_ / "p2").string()});
+  // Into a part of the same sweep, or a new folder: yes, one merge at a time.
+  { const MergeTarget into_part((dir_ / "p1").string(), merged); }
+  {
+    const MergeTarget first((dir_ / "whole").string(), merged);
+    try {
+      const MergeTarget second((dir_ / "whole").string(), merged);
+      ADD_FAILURE() << "two merges into one folder at once";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(contains(e.what(), {".merge-lock", "another merge is writing"}), "");
+    }
+  }
+  { const MergeTarget again((dir_ / "whole").string(), merged); }  // the lock went with the first
+  // Into the folder of another sweep: its tables would describe other episodes than its own.
+  run_sweep(plan_of("seeds: 3\naxes:\n  gain: [0.5, 1, 3]\n"), synthetic, (dir_ / "other").string(), {1, false, {}});
+  try {
+    const MergeTarget wrong((dir_ / "other").string(), merged);
+    ADD_FAILURE() << "merged into another sweep's folder";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(contains(e.what(), {(dir_ / "other" / "sweep.json").string(), "another sweep", "gain=3"}), "");
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "other" / ".merge-lock"));
+}
+
 // Replaces the first `from` in a file by `to`.
 void edit(const fs::path& file, const std::string& from, const std::string& to) {
   std::string text = slurp(file);

@@ -109,7 +109,9 @@ class OpenNi2Source : public FrameSource {
  */
 class OniWriter {
  public:
-  /// \throws std::runtime_error naming the path when it cannot be created.
+  /// \throws std::invalid_argument when `path` exists and is not a regular file (a device, a
+  ///         directory: its poses file would land beside it); std::runtime_error naming the path
+  ///         when it cannot be created.
   explicit OniWriter(const std::string& path, int fps = 30);
   ~OniWriter();
   OniWriter(const OniWriter&) = delete;

@@ -70,7 +70,8 @@ class PcdSequenceSource : public FrameSource {
 /// \brief Writes frames as a PCD sequence (binary PCD, poses.txt, intrinsics.txt).
 class PcdSequenceWriter {
  public:
-  /// \throws std::runtime_error naming the directory when it cannot be created.
+  /// \throws std::invalid_argument when `directory` exists and is not an empty
+  ///         directory (refuse_used_directory()); std::runtime_error naming it when it cannot be created.
   explicit PcdSequenceWriter(const std::string& directory);
   /// \throws std::invalid_argument for inconsistent buffers; std::runtime_error when a file cannot
   /// be written.

@@ -17,6 +17,10 @@
 
 namespace ofv {
 
+/// \brief Throws std::invalid_argument unless `directory` is new or an empty
+///        directory: a recording written into another would mix with it.
+void refuse_used_directory(const std::string& directory);
+
 /// \brief Largest image side [px] of a recorded sequence (images, intrinsics, PCD rows).
 constexpr int kMaxImageSide = 4096;
 

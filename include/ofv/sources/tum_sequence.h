@@ -83,7 +83,8 @@ class TumSequenceSource : public FrameSource {
  */
 class TumSequenceWriter {
  public:
-  /// \throws std::runtime_error naming the directory when it cannot be created.
+  /// \throws std::invalid_argument when `directory` exists and is not an empty
+  ///         directory (refuse_used_directory()); std::runtime_error naming it when it cannot be created.
   explicit TumSequenceWriter(const std::string& directory, double depth_factor = 5000.0);
   /// Images are named by timestamp, so timestamps must increase (by 1 us at least).
   /// \throws std::invalid_argument for inconsistent buffers or a timestamp that does

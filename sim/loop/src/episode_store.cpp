@@ -8,7 +8,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -380,6 +385,7 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
     }
   }
   if (!parts.empty()) {
+    out.plan = parts.front().sweep.plan;
     out.planned = parts.front().sweep.plan.size();
     for (const auto& s : parts.front().sweep.plan) {
       if (found.count(s.id()) == 0) out.missing.push_back(s);
@@ -392,5 +398,37 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
 }
 
 std::vector<EpisodeRow> load_episodes(const std::vector<std::string>& dirs) { return read_sweep(dirs).rows; }
+
+MergeTarget::MergeTarget(const std::string& out_dir, const SweepEpisodes& merged) {
+  const fs::path out(out_dir);
+  const fs::path record = out / "sweep.json";
+  if (fs::exists(record)) {
+    const std::string diff = plan_difference(read_record(record).plan, merged.plan);
+    if (!diff.empty()) {
+      throw std::invalid_argument(record.string() + ": the folder holds another sweep (" + diff +
+                                  "): merge into another --out");
+    }
+  } else if (fs::is_directory(out / "episodes") && !fs::is_empty(out / "episodes")) {
+    throw std::invalid_argument((out / "episodes").string() + ": episodes without sweep.json (another sweep, or an "
+                                "older ofv): merge into another --out");
+  }
+  fs::create_directories(out);
+  lock_ = (out / ".merge-lock").string();
+  const int fd = ::open(lock_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) {
+    const std::string why = errno == EEXIST ? "another merge is writing into " + out_dir +
+                                                  " (if none is, one was stopped: remove the file)"
+                                            : std::string("cannot create it: ") + std::strerror(errno);
+    lock_.clear();
+    throw std::invalid_argument((out / ".merge-lock").string() + ": " + why);
+  }
+  ::close(fd);
+}
+
+MergeTarget::~MergeTarget() {
+  if (lock_.empty()) return;
+  std::error_code ignored;
+  fs::remove(lock_, ignored);
+}
 
 }  // namespace ofv

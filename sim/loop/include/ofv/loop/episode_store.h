@@ -61,6 +61,7 @@ struct SweepEpisodes {
   std::vector<EpisodeRow> rows;      ///< sorted by their index in the sweep
   std::vector<EpisodeSpec> missing;  ///< episodes of the whole sweep finished in none of the folders
   std::size_t planned = 0;           ///< episodes of the whole sweep (every part)
+  std::vector<EpisodeSpec> plan;     ///< the whole sweep's episodes, in order
 };
 
 /**
@@ -77,6 +78,25 @@ struct SweepEpisodes {
  *         different results in two folders (naming both files).
  */
 [[nodiscard]] SweepEpisodes read_sweep(const std::vector<std::string>& dirs);
+
+/**
+ * \brief Where `ofv compare --merge` writes the tables of `merged`, held
+ *        for one merge at a time (a lock file `.merge-lock`, removed when
+ *        the object goes).
+ * \throws std::invalid_argument naming the folder: it holds episodes of
+ *         another sweep (its tables would describe other episodes than its
+ *         own), or another merge is writing into it.
+ */
+class MergeTarget {
+ public:
+  MergeTarget(const std::string& out_dir, const SweepEpisodes& merged);
+  ~MergeTarget();
+  MergeTarget(const MergeTarget&) = delete;             ///< one lock, one owner
+  MergeTarget& operator=(const MergeTarget&) = delete;  ///< one lock, one owner
+
+ private:
+  std::string lock_;
+};
 
 /// \brief read_sweep(dirs).rows: the finished episodes, sorted by scenario,
 ///        variant order, seed.
