@@ -89,8 +89,9 @@ struct SweepEpisodes {
  */
 class MergeTarget {
  public:
+  /// \brief Checks `out_dir` against `merged` and takes its lock (creating the folder).
   MergeTarget(const std::string& out_dir, const SweepEpisodes& merged);
-  ~MergeTarget();
+  ~MergeTarget();  ///< releases the lock
   MergeTarget(const MergeTarget&) = delete;             ///< one lock, one owner
   MergeTarget& operator=(const MergeTarget&) = delete;  ///< one lock, one owner
 
