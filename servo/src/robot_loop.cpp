@@ -58,7 +58,7 @@ class Watchdog {
     const std::lock_guard<std::mutex> robot(robot_mutex_);
     return robot_.wMc();
   }
-  /// A command took longer than the timeout.
+  /// A command took longer than its period plus the timeout.
   [[nodiscard]] bool blocked() {
     const std::lock_guard<std::mutex> lock(state_mutex_);
     return blocked_;
@@ -190,12 +190,10 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
         ++summary.bad_frames;
         bad_times.push_back(arrived);
         while (arrived - bad_times.front() > std::chrono::minutes(1)) bad_times.pop_front();
-        if (++bad_in_row > options.max_bad_frames_in_row ||
-            static_cast<long>(bad_times.size()) > options.max_bad_frames_per_minute) {
-          throw std::runtime_error(std::to_string(bad_in_row > options.max_bad_frames_in_row ? bad_in_row
-                                                                                             : bad_times.size()) +
-                                   (bad_in_row > options.max_bad_frames_in_row ? " bad frames in a row"
-                                                                               : " bad frames in a minute") +
+        const bool in_a_row = ++bad_in_row > options.max_bad_frames_in_row;
+        if (in_a_row || static_cast<long>(bad_times.size()) > options.max_bad_frames_per_minute) {
+          throw std::runtime_error((in_a_row ? std::to_string(bad_in_row) + " bad frames in a row"
+                                             : std::to_string(bad_times.size()) + " bad frames in a minute") +
                                    ", the last: " + out.bad_frame);
         }
         loop.robot_stopped();
