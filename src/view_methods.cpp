@@ -132,6 +132,7 @@ const char* to_string(ViewMethod m) {
     case ViewMethod::Static: return "static";
     case ViewMethod::InitialView: return "initial_view";
     case ViewMethod::Sampling: return "sampling";
+    case ViewMethod::Hindsight: return "hindsight";
   }
   return "?";
 }

@@ -262,6 +262,7 @@ Command add_run_command(CLI::App& app) {
                       "(or, with --set select=auto, the cluster nearest the image centre)");
                 }
                 setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
+                if (setup.loop.method == ViewMethod::Hindsight) throw std::invalid_argument(servo::kHindsightIsSimulationOnly);
                 setup.real_time = true;
                 if (setup.robot == servo::RobotKind::Camera) {
                   throw std::invalid_argument("--source sim: needs --robot viper850 or afma6 (ViSP's threaded simulators)");
@@ -271,6 +272,7 @@ Command add_run_command(CLI::App& app) {
                 setup.duration = std::numeric_limits<double>::infinity();
                 episode_settings_table().apply(setup, settings);
                 (void)servo::ViewLoop(setup.loop);  // validates
+                if (setup.loop.method == ViewMethod::Hindsight) throw std::invalid_argument(servo::kHindsightIsSimulationOnly);
                 const bool select = std::any_of(settings.begin(), settings.end(), [](const auto& s) { return s.first == "select"; });
                 if (setup.perception != PerceptionMode::Full || setup.seed != 0 || setup.real_time || select) {
                   throw std::invalid_argument(

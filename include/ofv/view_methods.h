@@ -30,9 +30,13 @@ enum class ViewMethod {
   Static,     ///< keep the camera where it is
   InitialView,  ///< occlusion-blind t0
   Sampling,   ///< best of many candidate views on the sphere
+  /// The best path in hindsight, planned before the episode from the
+  /// simulator's knowledge of the future (sim::plan_hindsight): the limit
+  /// of any method, simulation only (the loop follows it, ofv::servo::ViewLoop::follow).
+  Hindsight,
 };
 
-/// \brief The method's word in settings and files: estimator, static, initial_view, sampling.
+/// \brief The method's word in settings and files: estimator, static, initial_view, sampling, hindsight.
 [[nodiscard]] const char* to_string(ViewMethod m);
 
 /// \brief `n` unit directions spread evenly on the sphere (Fibonacci lattice).

@@ -48,14 +48,16 @@ SettingsTable<LoopSettings> make_table() {
   const LoopSettings d;
   SettingsTable<L> t;
   t.include(estimator_settings_table(), [](auto& l) -> auto& { return l.estimator; });
-  t.add({"method", "estimator | static | initial_view | sampling", to_string(d.method), "",
-         "how the target view is chosen: the occlusion-free view, or a baseline"},
+  t.add({"method", "estimator | static | initial_view | sampling | hindsight", to_string(d.method), "",
+         "how the target view is chosen: the occlusion-free view, or a baseline; hindsight: the best path planned "
+         "from the simulator's knowledge of the whole episode (the limit; simulation only)"},
         [](L& l, const std::string& v) {
           l.method = parse_word<ViewMethod>("method", v,
                                             {{"estimator", ViewMethod::Estimator},
                                              {"static", ViewMethod::Static},
                                              {"initial_view", ViewMethod::InitialView},
-                                             {"sampling", ViewMethod::Sampling}});
+                                             {"sampling", ViewMethod::Sampling},
+                                             {"hindsight", ViewMethod::Hindsight}});
         },
         [](const L& l) { return std::string(to_string(l.method)); });
   t.add({"sampling_candidates", "integer in [1, 1000000]", std::to_string(d.sampling.candidates), "",

@@ -10,6 +10,7 @@ const char* to_string(StepStatus status) {
     case StepStatus::NoOccluders: return "no_occluders";
     case StepStatus::ObjectLost: return "object_lost";
     case StepStatus::BadFrame: return "bad_frame";
+    case StepStatus::Planned: return "planned";
   }
   return "?";
 }
@@ -51,6 +52,7 @@ const char* to_string(Proposer proposer) {
     case Proposer::BestSeen: return "best_seen";
     case Proposer::InitialView: return "initial_view";
     case Proposer::Sampling: return "sampling";
+    case Proposer::Plan: return "plan";
   }
   return "?";
 }

@@ -133,6 +133,7 @@ class Watchdog {
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,
                               const std::function<void(const RobotLoopFrame&)>& on_frame) {
+  if (settings.method == ViewMethod::Hindsight) throw std::invalid_argument(kHindsightIsSimulationOnly);
   ViewLoop loop(settings);
   Watchdog watchdog(robot, settings.safety.stale_timeout, options.move_robot && options.watchdog);
   const auto rest = [&] {

@@ -113,7 +113,28 @@ ViewLoop::ViewLoop(const LoopSettings& settings) : impl_(std::make_unique<Impl>(
 ViewLoop::~ViewLoop() = default;
 ViewLoop::ViewLoop(ViewLoop&&) noexcept = default;
 ViewLoop& ViewLoop::operator=(ViewLoop&&) noexcept = default;
-LoopStep ViewLoop::step(const Observation& observation, double dt) { return impl_->step(observation, dt); }
+LoopStep ViewLoop::step(const Observation& observation, double dt) {
+  if (impl_->settings.method == ViewMethod::Hindsight) {
+    throw std::logic_error("method hindsight follows a path planned in simulation: use ViewLoop::follow");
+  }
+  return impl_->step(observation, dt);
+}
+
+LoopStep ViewLoop::follow(const Eigen::Vector3d& target, const Eigen::Vector3d& centroid, const Eigen::Isometry3d& wMc,
+                          double age, double dt) {
+  LoopStep out;
+  const auto start = Clock::now();
+  out.status = StepStatus::Planned;
+  out.mode = impl_->mode = LoopMode::Pursue;
+  out.proposer = Proposer::Plan;
+  out.target = target;
+  const vpHomogeneousMatrix pose = to_visp(wMc);
+  out.command = impl_->controller.update(target, centroid, impl_->estimator.r_sphere, pose, dt);
+  out.velocity = impl_->safety.filter(out.command, pose, dt, true, age);
+  out.safety = impl_->safety.last_action();
+  out.control_s = seconds_since(start);
+  return out;
+}
 void ViewLoop::robot_stopped() { impl_->safety.reset(); }
 LoopMode ViewLoop::mode() const { return impl_->mode; }
 void ViewLoop::reset() { impl_ = std::make_unique<Impl>(impl_->settings); }
@@ -191,6 +212,7 @@ Candidate ViewLoop::Impl::pursue(const ViewProblem& problem, const OcclusionFiel
           score_view(*basis, previous, rho).visible_fraction >= score_view(*basis, best, rho).visible_fraction;
       return {keep ? previous : best, Proposer::Sampling};
     }
+    case ViewMethod::Hindsight:  // follow() drives it; step() refuses it
     case ViewMethod::Estimator: break;
   }
   if (settings.target_hysteresis && previous_target && chosen.iterations > 0) {

@@ -3,6 +3,8 @@
 #include "ofv/constants.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -115,22 +117,63 @@ struct Renderer::Impl {
     if (device != nullptr) rtcReleaseDevice(device);
   }
 
-  [[nodiscard]] bool occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRay ray{};
-    ray.org_x = static_cast<float>(from.x());
-    ray.org_y = static_cast<float>(from.y());
-    ray.org_z = static_cast<float>(from.z());
-    const Eigen::Vector3d d = to - from;
-    ray.dir_x = static_cast<float>(d.x());
-    ray.dir_y = static_cast<float>(d.y());
-    ray.dir_z = static_cast<float>(d.z());
-    ray.tnear = 0.0f;
-    ray.tfar = static_cast<float>(1.0 - 1e-4);  // stop short of the point itself
-    ray.mask = 0xFFFFFFFFu;
-    rtcOccluded1(scene, &context, &ray);
-    return ray.tfar < 0.0f;
+  // The object's surface samples at the current time.
+  [[nodiscard]] std::vector<WorldPoint> object_points() const {
+    const TriangleMesh& m = world[static_cast<std::size_t>(object)];
+    std::vector<WorldPoint> points;
+    points.reserve(samples[static_cast<std::size_t>(object)].size());
+    for (const auto& s : samples[static_cast<std::size_t>(object)]) points.push_back(at(m, s));
+    return points;
+  }
+
+  // The fraction of the samples facing a camera at wMc that it sees: in its
+  // image, within its depth range and with nothing in between.
+  [[nodiscard]] double visible_fraction(const std::vector<WorldPoint>& points, const Eigen::Isometry3d& wMc,
+                                        const SensorSettings& sensor) const {
+    const Eigen::Vector3d o = wMc.translation();
+    const Eigen::Isometry3d cMw = wMc.inverse();
+    const CameraIntrinsics& k = sensor.intrinsics;
+    int facing = 0, seen = 0;
+    // Rays from the camera to the samples it may see, 8 to a packet.
+    constexpr int kPacket = 8;
+    alignas(32) int valid[kPacket];
+    RTCRay8 ray;
+    for (int j = 0; j < kPacket; ++j) {
+      ray.org_x[j] = static_cast<float>(o.x());
+      ray.org_y[j] = static_cast<float>(o.y());
+      ray.org_z[j] = static_cast<float>(o.z());
+      ray.mask[j] = 0xFFFFFFFFu;
+      ray.time[j] = 0.0f;
+      ray.flags[j] = 0;
+    }
+    int filled = 0;
+    auto trace = [&] {
+      for (int j = filled; j < kPacket; ++j) valid[j] = 0;
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      rtcOccluded8(valid, scene, &context, &ray);
+      for (int j = 0; j < filled; ++j) seen += ray.tfar[j] < 0.0f ? 0 : 1;
+      filled = 0;
+    };
+    for (const WorldPoint& w : points) {
+      if (w.n.dot(o - w.p) <= 0.0) continue;
+      ++facing;
+      const Eigen::Vector3d pc = cMw * w.p;
+      if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth) continue;
+      const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
+      if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
+      const Eigen::Vector3d d = w.p - o;
+      valid[filled] = -1;
+      ray.dir_x[filled] = static_cast<float>(d.x());
+      ray.dir_y[filled] = static_cast<float>(d.y());
+      ray.dir_z[filled] = static_cast<float>(d.z());
+      ray.tnear[filled] = 0.0f;
+      ray.tfar[filled] = static_cast<float>(1.0 - 1e-4);  // stop short of the point itself
+      if (++filled == kPacket) trace();
+    }
+    if (filled > 0) trace();
+    return facing > 0 ? static_cast<double>(seen) / facing : 0.0;
   }
 };
 
@@ -351,24 +394,8 @@ void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing,
 
 ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {
   ObjectTruth t;
-  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
-  const auto& samples = impl_->samples[static_cast<std::size_t>(impl_->object)];
-  const Eigen::Vector3d o = wMc.translation();
-  const Eigen::Isometry3d cMw = wMc.inverse();
-  const CameraIntrinsics& k = scenario_.sensor.intrinsics;
-  int facing = 0, seen = 0;
   t.centroid = object_centroid();
-  for (const auto& s : samples) {
-    const WorldPoint w = at(m, s);
-    if (w.n.dot(o - w.p) <= 0.0) continue;
-    ++facing;
-    const Eigen::Vector3d pc = cMw * w.p;
-    if (pc.z() < scenario_.sensor.min_depth || pc.z() > scenario_.sensor.max_depth) continue;
-    const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
-    if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
-    if (!impl_->occluded(o, w.p)) ++seen;
-  }
-  t.visible_fraction = facing > 0 ? static_cast<double>(seen) / facing : 0.0;
+  t.visible_fraction = impl_->visible_fraction(impl_->object_points(), wMc, scenario_.sensor);
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     if (scenario_.bodies[b].role != Role::Occluder) continue;
     const auto& verts = impl_->world[b].vertices;
@@ -389,11 +416,24 @@ Eigen::Vector3d Renderer::object_centroid() const {
 }
 
 std::vector<Eigen::Vector3d> Renderer::object_surface() const {
-  const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(impl_->samples[static_cast<std::size_t>(impl_->object)].size());
-  for (const auto& s : impl_->samples[static_cast<std::size_t>(impl_->object)]) points.push_back(at(m, s).p);
+  const std::vector<WorldPoint> samples = impl_->object_points();
+  std::vector<Eigen::Vector3d> points(samples.size());
+  std::transform(samples.begin(), samples.end(), points.begin(), [](const WorldPoint& w) { return w.p; });
   return points;
+}
+
+std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometry3d>& poses) const {
+  for (const Eigen::Isometry3d& wMc : poses) {
+    if (!wMc.matrix().allFinite()) throw std::invalid_argument("renderer: a camera pose is not finite");
+  }
+  const std::vector<WorldPoint> points = impl_->object_points();
+  std::vector<double> fractions(poses.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      fractions[i] = impl_->visible_fraction(points, poses[i], scenario_.sensor);
+    }
+  });
+  return fractions;
 }
 
 int occluders_seen(const std::vector<std::uint16_t>& labels) {

@@ -61,6 +61,14 @@ SettingsTable<EpisodeSetup> make_table() {
          "stay within stale_timeout"},
         [](E& e, const std::string& v) { e.latency = static_cast<int>(parse_integer("latency", v, 0, 30)); },
         [](const E& e) { return std::to_string(e.latency); });
+  t.add({"hindsight_spacing", "number in [0.002, 0.2]", format_number(d.hindsight.spacing), "m",
+         "method hindsight: spacing of the views on the sphere (each stands for spacing^2 of its area)"},
+        [](E& e, const std::string& v) { e.hindsight.spacing = parse_number("hindsight_spacing", v, 0.002, 0.2, false); },
+        [](const E& e) { return format_number(e.hindsight.spacing); });
+  t.add({"hindsight_step", "integer in [1, 30]", std::to_string(d.hindsight.frames_per_step), "frames",
+         "method hindsight: the planner's time step, in frame periods"},
+        [](E& e, const std::string& v) { e.hindsight.frames_per_step = static_cast<int>(parse_integer("hindsight_step", v, 1, 30)); },
+        [](const E& e) { return std::to_string(e.hindsight.frames_per_step); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
          "run the arm on ViSP's threaded simulator in wall-clock time (robot viper850 or afma6)"},
         [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); },
@@ -238,6 +246,19 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   const perception::PerceptionSettings front_end = front_end_settings(setup);
   std::optional<perception::PerceptionObserver> perception;  // full, labels: made on the first frame, which may point out the object
 
+  // Method hindsight: the path planned from the whole episode, followed a
+  // controller time constant (the adaptive gain's at zero error) plus the
+  // latency ahead, so that the camera is on it rather than behind it.
+  std::optional<sim::HindsightPlan> plan;
+  double lead = 0.0;
+  if (setup.loop.method == ViewMethod::Hindsight) {
+    sim::HindsightSettings h = setup.hindsight;
+    h.max_speed = setup.loop.controller.max_linear_speed;
+    plan = sim::plan_hindsight(scenario, scenario.wMc_start, loop.estimator().r_sphere, setup.duration, h);
+    const servo::ControllerSettings& c = setup.loop.controller;
+    lead = dt * setup.latency + 1.0 / (c.adaptive_gain ? 2.0 * c.gain : c.gain);
+  }
+
   // Commands on their way to the robot, oldest first.
   std::deque<vpColVector> in_flight(static_cast<std::size_t>(setup.latency), vpColVector(6, 0.0));
   EpisodeOutcome outcome;
@@ -259,27 +280,34 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     ViewProblem gt_problem = record_truth(rec, renderer, loop.estimator());
     rec.occluders_in_view = sim::occluders_seen(rendered.frame.labels);
 
-    start = Clock::now();
-    if (setup.perception != PerceptionMode::GroundTruth && !perception) {
-      perception::PerceptionSettings settings = front_end;
-      if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.frame.labels);
-      perception.emplace(settings);
-    }
-    Observation observation = perception ? perception->observe(rendered.frame)
-                                          : truth_observation(rendered.frame, std::move(gt_problem), front_end);
-    rec.times.perception = seconds_since(start);
-    if (perception) rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
-
     // The frame is as old as 1 + latency periods when its command is replaced.
-    observation.age = dt * (1 + setup.latency);
-    const servo::LoopStep step = loop.step(observation, dt);
+    const double age = dt * (1 + setup.latency);
+    std::optional<Observation> observation;
+    servo::LoopStep step;
+    if (plan) {
+      const double ahead = rec.time + lead;
+      step = loop.follow(plan->view_at(ahead), plan->centroid_at(ahead), wMc, age, dt);
+    } else {
+      start = Clock::now();
+      if (setup.perception != PerceptionMode::GroundTruth && !perception) {
+        perception::PerceptionSettings settings = front_end;
+        if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.frame.labels);
+        perception.emplace(settings);
+      }
+      observation = perception ? perception->observe(rendered.frame)
+                               : truth_observation(rendered.frame, std::move(gt_problem), front_end);
+      rec.times.perception = seconds_since(start);
+      if (perception) rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
+      observation->age = age;
+      step = loop.step(*observation, dt);
+    }
     record_step(rec, step);
 
     outcome.steps.push_back(rec);
     if (observer) {
       StepDetail detail;
       detail.frame = &rendered.frame;
-      detail.observation = &observation;
+      detail.observation = observation ? &*observation : nullptr;
       detail.step = &step;
       observer(rec, detail);
     }
@@ -288,6 +316,17 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     in_flight.pop_front();
   }
   outcome.metrics = summarise(outcome.steps);
+  if (plan) {
+    HindsightBound& b = outcome.metrics.hindsight.emplace();
+    b.planned = plan->bound;
+    b.unlimited = plan->unlimited_bound;
+    b.views = plan->lattice_views;
+    b.steps = static_cast<int>(plan->times.size());
+    b.step = plan->step;
+    b.spacing = setup.hindsight.spacing;
+    b.evaluations = plan->evaluations;
+    b.plan_s = plan->seconds;
+  }
   return outcome;
 }
 

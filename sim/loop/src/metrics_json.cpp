@@ -79,6 +79,24 @@ PerceptionSummary perception_from_json(const json& j) {
   return p;
 }
 
+json hindsight_to_json(const HindsightBound& h) {
+  return {{"planned", h.planned}, {"unlimited_speed", h.unlimited}, {"views", h.views},         {"steps", h.steps},
+          {"step_s", h.step},     {"spacing_m", h.spacing},         {"evaluations", h.evaluations}, {"plan_s", h.plan_s}};
+}
+
+HindsightBound hindsight_from_json(const json& j) {
+  HindsightBound h;
+  h.planned = j.at("planned").get<double>();
+  h.unlimited = j.at("unlimited_speed").get<double>();
+  h.views = j.at("views").get<int>();
+  h.steps = j.at("steps").get<int>();
+  h.step = j.at("step_s").get<double>();
+  h.spacing = j.at("spacing_m").get<double>();
+  h.evaluations = j.at("evaluations").get<long>();
+  h.plan_s = j.at("plan_s").get<double>();
+  return h;
+}
+
 }  // namespace
 
 json metrics_to_json(const EpisodeMetrics& m) {
@@ -114,7 +132,8 @@ json metrics_to_json(const EpisodeMetrics& m) {
           {"estimator_calls_max", m.estimator_calls_max},
           {"status_counts", statuses},
           {"mode_counts", modes},
-          {"perception", perception_to_json(m.perception)}};
+          {"perception", perception_to_json(m.perception)},
+          {"hindsight_bound", m.hindsight ? hindsight_to_json(*m.hindsight) : json()}};
 }
 
 EpisodeMetrics metrics_from_json(const json& j) {
@@ -152,6 +171,7 @@ EpisodeMetrics metrics_from_json(const json& j) {
   }
   // Episodes written before the perception scores have none.
   if (j.contains("perception")) m.perception = perception_from_json(j.at("perception"));
+  if (j.contains("hindsight_bound") && !j.at("hindsight_bound").is_null()) m.hindsight = hindsight_from_json(j.at("hindsight_bound"));
   return m;
 }
 

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -69,6 +70,45 @@ std::string episodes_csv(const std::vector<EpisodeRow>& rows) {
   return csv.str();
 }
 
+// The limit of each scenario and seed: the episode of method hindsight
+// (its executed path), if the sweep ran one.
+class Limits {
+ public:
+  explicit Limits(const std::vector<EpisodeRow>& rows) {
+    for (const EpisodeRow& r : rows) {
+      if (r.metrics.hindsight) limit_.emplace(std::make_pair(r.spec.scenario, r.spec.seed), &r.metrics);
+    }
+  }
+  [[nodiscard]] bool any() const { return !limit_.empty(); }
+  // A group's distance to the limit in `column`, seed by seed (its value minus the limit's).
+  [[nodiscard]] Interval distance(const EpisodeGroup& g, const MetricColumn& column) const {
+    std::vector<double> d;
+    for (const EpisodeRow& r : g.rows) {
+      const auto it = limit_.find(std::make_pair(r.spec.scenario, r.spec.seed));
+      if (it != limit_.end()) d.push_back(column.get(r.metrics) - column.get(*it->second));
+    }
+    return mean_interval(d);
+  }
+
+ private:
+  std::map<std::pair<std::string, unsigned>, const EpisodeMetrics*> limit_;
+};
+
+// The columns compared with the limit: visibility and time below the threshold.
+const std::vector<MetricColumn>& limit_columns() {
+  static const std::vector<MetricColumn> c{
+      {"to_limit_visible_fraction", "to limit: visible", [](const EpisodeMetrics& m) { return m.mean_visible_fraction; }},
+      {"to_limit_time_below_threshold_s", "to limit: below 0.9 [s]",
+       [](const EpisodeMetrics& m) { return m.time_below_threshold; }},
+  };
+  return c;
+}
+
+std::string md_cell(const Interval& i) {
+  if (i.n == 0) return " n/a |";
+  return ' ' + csv_number(i.mean, 3) + (i.n >= 2 ? " ± " + csv_number(i.half_width, 2) : "") + " |";
+}
+
 }  // namespace
 
 std::string csv_field(const std::string& text) {
@@ -90,35 +130,47 @@ void write_tables(const std::vector<EpisodeRow>& rows, const std::string& out_di
   fs::create_directories(out);
   write_file_atomically(out / "episodes.csv", episodes_csv(rows));
 
-  // summary.csv and summary.md: per scenario x variant, in sweep order.
+  // summary.csv and summary.md: per scenario x variant, in sweep order;
+  // with a hindsight variant, each variant's distance to it (the limit).
   const EpisodeGroups grouped = group_episodes(rows);
+  const Limits limits(rows);
   std::ostringstream csv, md;
   csv << "scenario,variant,settings,seeds";
   for (const auto& c : metric_columns()) csv << ',' << c.name << ',' << c.name << "_ci95";
+  if (limits.any()) {
+    for (const auto& c : limit_columns()) csv << ',' << c.name << ',' << c.name << "_ci95";
+  }
   csv << '\n';
   md << "# Closed-loop comparison\n\nMean over seeds, ± the 95 % confidence half-width "
         "(Student t). Visible fraction is the true fraction of the object's surface the "
         "camera sees; recovery is the time from visibility falling below 0.9 until it is "
         "back (dips less than 0.2 s apart are one occlusion).\n";
+  if (limits.any()) {
+    md << "\nThe limit is the hindsight variant (method hindsight: the best camera path planned with the whole "
+          "episode known, followed by the same controller); \"to limit\" is each variant's value minus the "
+          "limit's, seed by seed.\n";
+  }
   for (const auto& scenario : grouped.scenarios) {
     md << "\n## " << md_text(scenario) << "\n\n| variant | seeds |";
     for (const auto& c : metric_columns()) md << ' ' << c.label << " |";
+    if (limits.any()) {
+      for (const auto& c : limit_columns()) md << ' ' << c.label << " |";
+    }
     md << "\n|---|---|";
-    for (std::size_t k = 0; k < metric_columns().size(); ++k) md << "---|";
+    for (std::size_t k = 0; k < metric_columns().size() + (limits.any() ? limit_columns().size() : 0); ++k) md << "---|";
     md << '\n';
     for (const auto& g : grouped.groups) {
       if (g.scenario != scenario) continue;
       csv << csv_field(g.scenario) << ',' << csv_field(g.variant.name) << ','
           << csv_field(settings_text(g.variant)) << ',' << g.rows.size();
       md << "| " << md_text(g.variant.name) << " | " << g.rows.size() << " |";
-      for (const auto& c : metric_columns()) {
-        const Interval i = g.interval(c);
+      const auto cell = [&](const Interval& i) {
         csv << ',' << csv_number(i.mean) << ',' << csv_number(i.half_width);
-        if (i.n == 0) {
-          md << " n/a |";
-        } else {
-          md << ' ' << csv_number(i.mean, 3) << (i.n >= 2 ? " ± " + csv_number(i.half_width, 2) : "") << " |";
-        }
+        md << md_cell(i);
+      };
+      for (const auto& c : metric_columns()) cell(g.interval(c));
+      if (limits.any()) {
+        for (const auto& c : limit_columns()) cell(limits.distance(g, c));
       }
       csv << '\n';
       md << '\n';

@@ -62,6 +62,7 @@ const std::vector<MetricColumn>& metric_columns() {
       {"max_estimate_ms", "worst estimate [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.max_times.estimate; }},
       {"mean_step_ms", "whole step [ms]", [](const EpisodeMetrics& m) { return 1e3 * m.mean_times.total(); }},
       // Perception scores, means over the frames (n/a with ground-truth perception).
+      {"hindsight_bound", "limit planned", [](const EpisodeMetrics& m) { return m.hindsight ? m.hindsight->planned : std::nan(""); }},
       {"object_precision", "obj. precision", [](const EpisodeMetrics& m) { return mean_score(m.perception.object_precision); }},
       {"object_recall", "obj. recall", [](const EpisodeMetrics& m) { return mean_score(m.perception.object_recall); }},
       {"occluder_precision", "occl. precision", [](const EpisodeMetrics& m) { return mean_score(m.perception.occluder_precision); }},

@@ -16,8 +16,9 @@ enum class StepStatus {
   NoOccluders,   ///< nothing occludes: t0
   ObjectLost,    ///< no object this frame (perception lost it, or no usable supervoxel): the robot stops
   BadFrame,      ///< the frame failed its checks and was skipped (run_on_robot): the robot stops
+  Planned,       ///< method hindsight: the planned path's view (ViewLoop::follow)
 };
-/// \brief The status's word in files: converged, not_converged, no_occluders, object_lost, bad_frame.
+/// \brief The status's word in files: converged, not_converged, no_occluders, object_lost, bad_frame, planned.
 [[nodiscard]] const char* to_string(StepStatus status);
 
 /// \brief What the safety filter did to a command.
@@ -90,6 +91,7 @@ enum class Proposer {
   BestSeen,     ///< the view that showed the most of the object (modes hold and way back)
   InitialView,  ///< baseline method initial_view: t0
   Sampling,     ///< baseline method sampling
+  Plan,         ///< method hindsight: the planned path (ViewLoop::follow)
 };
 /// \brief The word in files and on the terminal, e.g. estimate, warm_start.
 [[nodiscard]] const char* to_string(Proposer proposer);

@@ -91,7 +91,7 @@ struct RobotLoopSummary {
  * \param settings the loop's settings (ofv::servo::ViewLoop)
  * \param options  how the source and the robot are treated
  * \param on_frame sees every frame after its command is sent; may be empty.
- * \throws std::invalid_argument for invalid settings; whatever the source,
+ * \throws std::invalid_argument for invalid settings (method hindsight among them); whatever the source,
  *         observer or robot throw at run time but the observer's refusals of
  *         single frames; std::runtime_error when a command to the robot did
  *         not return within its period plus `stale_timeout` (watchdog), or
@@ -100,6 +100,11 @@ struct RobotLoopSummary {
 RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRobot& robot,
                               const LoopSettings& settings, const RobotLoopOptions& options,
                               const std::function<void(const RobotLoopFrame&)>& on_frame = {});
+
+/// \brief Why run_on_robot() (and `ofv run`) refuse method hindsight.
+inline constexpr const char* kHindsightIsSimulationOnly =
+    "setting method = hindsight plans from the simulator's knowledge of the whole episode: it runs in ofv simulate "
+    "and ofv compare, not on a robot, a recording or a rehearsal";
 
 }  // namespace ofv::servo
 

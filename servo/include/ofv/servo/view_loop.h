@@ -219,6 +219,19 @@ class ViewLoop {
    */
   [[nodiscard]] LoopStep step(const Observation& observation, double dt);
 
+  /**
+   * \brief Drives to a view chosen outside the loop (method hindsight: the
+   *        planned path) through the loop's controller and safety filter;
+   *        no view selection, world model or modes (the mode is pursue).
+   * \param target   the camera position to drive to (world) [m].
+   * \param centroid the point the camera looks at (world) [m].
+   * \param wMc      the camera's pose when the frame was taken.
+   * \param age      the frame's age when the command is sent [s] (as Observation::age).
+   * \param dt       as step().
+   */
+  [[nodiscard]] LoopStep follow(const Eigen::Vector3d& target, const Eigen::Vector3d& centroid,
+                                const Eigen::Isometry3d& wMc, double age, double dt);
+
   /// \brief The robot was stopped outside the loop (a watchdog, a skipped
   ///        frame): the next command starts from rest within the
   ///        acceleration limits.

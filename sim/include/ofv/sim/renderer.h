@@ -81,6 +81,14 @@ class Renderer {
   /// \brief Object ground truth seen from a camera at `wMc` (r_sphere for the occluder count).
   [[nodiscard]] ObjectTruth truth(const Eigen::Isometry3d& wMc, double r_sphere) const;
 
+  /**
+   * \brief truth()'s visible fraction from each camera pose at the current
+   *        time, the poses shared out among threads (oneTBB): what a planner
+   *        that scores many views of one instant asks for.
+   * \throws std::invalid_argument when a pose is not finite.
+   */
+  [[nodiscard]] std::vector<double> visible_fractions(const std::vector<Eigen::Isometry3d>& poses) const;
+
   /// \brief The object's area-weighted surface centroid (truth()'s) at the current time [m].
   [[nodiscard]] Eigen::Vector3d object_centroid() const;
   /// \brief The object's surface samples (those of truth()) at the current time [m].

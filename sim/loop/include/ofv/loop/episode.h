@@ -17,6 +17,7 @@
 #include "ofv/servo/robot_loop.h"
 #include "ofv/servo/view_loop.h"
 #include "ofv/settings_table.h"
+#include "ofv/sim/hindsight.h"
 #include "ofv/sim/scenario.h"
 
 #include <functional>
@@ -76,13 +77,16 @@ struct EpisodeSetup {
   /// The arms on ViSP's threaded simulators (ThreadedArm), one frame period
   /// of wall-clock time per step: a real-time demo, not exactly repeatable.
   bool real_time = false;
+  /// Method hindsight: the planner's lattice spacing and time step (settings
+  /// hindsight_spacing, hindsight_step); its speed limit is the loop's max_linear_speed.
+  sim::HindsightSettings hindsight;
 };
 
 /**
  * \brief Every setting of an episode by name: the loop's
  *        (ofv::servo::loop_settings_table()), the front end's
  *        (ofv::perception::perception_settings_table()) and robot, perception, select,
- *        duration, seed, latency, real_time. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        duration, seed, latency, real_time, hindsight_spacing, hindsight_step. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
 [[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();
@@ -116,7 +120,13 @@ inline constexpr double kMaxEpisodeDuration = 86400.0;
 /// \brief Most frames in one episode: kMaxEpisodeDuration at the scenarios' highest rate, 1000 Hz.
 inline constexpr double kMaxEpisodeFrames = 86400.0 * 1000.0;
 
-/// \brief Runs one episode.
+/**
+ * \brief Runs one episode. With method hindsight, the path is planned first
+ *        (sim::plan_hindsight, from the episode's start, r_sphere and
+ *        max_linear_speed) and the loop follows it (ofv::servo::ViewLoop::follow:
+ *        the plan's view and centroid one controller time constant plus the
+ *        latency ahead); no perception runs, and the metrics carry the bounds.
+ */
 /// \throws std::invalid_argument naming `duration` or `rate` when the episode
 ///         is not finite or has more than kMaxEpisodeFrames frames (however
 ///         the setup was made); std::runtime_error when the loop cannot run

@@ -105,6 +105,20 @@ struct OcclusionEvent {
   std::optional<double> occluder_in_view;
 };
 
+/// \brief The limit of an episode, from the hindsight planner (method
+///        hindsight, sim::plan_hindsight; `metrics.json` "hindsight_bound").
+///        The episode's mean visible fraction is what following the plan gave.
+struct HindsightBound {
+  double planned = 0.0;    ///< the planned path's mean visible fraction: the limit under the speed limit [0, 1]
+  double unlimited = 0.0;  ///< the best view at each step on its own: the limit without a speed limit [0, 1]
+  int views = 0;           ///< lattice views on the sphere
+  int steps = 0;           ///< time steps
+  double step = 0.0;       ///< time step [s]
+  double spacing = 0.0;    ///< lattice spacing [m]
+  long evaluations = 0;    ///< visibility evaluations made
+  double plan_s = 0.0;     ///< planning time [s]
+};
+
 /// \brief Summary of an episode.
 struct EpisodeMetrics {
   int steps = 0;                        ///< frame periods (StepRecord) summarised
@@ -129,6 +143,7 @@ struct EpisodeMetrics {
   std::vector<std::pair<std::string, int>> status_counts;  ///< steps per status
   std::vector<std::pair<std::string, int>> mode_counts;    ///< steps per loop mode (LoopMode)
   PerceptionSummary perception;  ///< empty (scored() false) with ground-truth perception
+  std::optional<HindsightBound> hindsight;  ///< method hindsight only
 };
 
 /**

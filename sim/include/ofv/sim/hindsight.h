@@ -1,0 +1,80 @@
+/**
+ * \file hindsight.h
+ * \brief The limit of any view selection on a scenario: the camera path on
+ *        the sphere that keeps the most of the object in view over the
+ *        whole episode, planned from the simulator's knowledge of the
+ *        future under the camera's speed limit (`method=hindsight`).
+ *
+ * Candidate views are a lattice of directions on the sphere of radius
+ * r_sphere around the object's true centroid, which moves with the object:
+ * view v at step i is c_i + r_sphere d_v. Time advances in steps of
+ * `frames_per_step` frame periods. The value of view v at step i is the true
+ * visible fraction of the object from there, looking at c_i
+ * (sim::Renderer::visible_fractions(), the ray casting of the episode's
+ * metrics). A move from view u at step i-1 to view v at step i is allowed
+ * when the camera travels at most max_speed x the step between the two
+ * positions. Dynamic programming over (step, view) gives the path with the
+ * largest sum of values: exact for the lattice and the steps, not a
+ * heuristic search. The camera starts where the scenario puts it; off its
+ * sphere, it first reaches the sphere along the radius at full speed.
+ *
+ * The cost is views x steps visibility evaluations (each ray casts the
+ * object's surface samples that face the view) plus views x neighbours x
+ * steps for the programme; HindsightPlan records both counts and the time.
+ */
+#pragma once
+
+#include "ofv/sim/scenario.h"
+
+#include <Eigen/Geometry>
+
+#include <vector>
+
+namespace ofv::sim {
+
+/// \brief The discretisation and the camera limit of the hindsight planner.
+struct HindsightSettings {
+  /// Lattice spacing: each view stands for spacing² of the sphere's area [m].
+  double spacing = 0.01;
+  /// Frame periods per time step (the values are taken at the steps).
+  int frames_per_step = 1;
+  /// The camera's speed limit [m/s] (the episode's max_linear_speed).
+  double max_speed = 0.5;
+};
+
+/// \brief A planned camera path and the bounds it gives.
+struct HindsightPlan {
+  double step = 0.0;                      ///< time step [s]
+  std::vector<double> times;              ///< step times, from 0 [s]
+  std::vector<Eigen::Vector3d> views;     ///< the planned camera position at each step (world) [m]
+  std::vector<Eigen::Vector3d> centroids; ///< the object's true centroid at each step [m]
+  std::vector<double> visible;            ///< the planned path's visible fraction at each step [0, 1]
+  std::vector<double> best_visible;       ///< the best lattice view's at each step, on its own [0, 1]
+  double bound = 0.0;            ///< mean of `visible`: the limit under the speed limit
+  double unlimited_bound = 0.0;  ///< mean of `best_visible`: the limit without a speed limit
+  int lattice_views = 0;         ///< views on the sphere
+  long evaluations = 0;          ///< visibility evaluations (views x steps and the approach)
+  double seconds = 0.0;          ///< planning time (wall clock) [s]
+
+  /// \brief The planned position at time t [s]: between two steps on the
+  ///        great circle around the interpolated centroid, the last step's after the end.
+  [[nodiscard]] Eigen::Vector3d view_at(double t) const;
+  /// \brief The object's true centroid at time t, interpolated as view_at() [m].
+  [[nodiscard]] Eigen::Vector3d centroid_at(double t) const;
+};
+
+/**
+ * \brief Plans the best camera path of an episode in hindsight.
+ * \param scenario  the world (already varied for its seed).
+ * \param wMc_start the camera's pose at time 0 (its orientation sets the
+ *                  views' roll: the least rotation that points it at the centroid).
+ * \param r_sphere  the sphere's radius [m].
+ * \param duration  the episode's length [s]; steps cover [0, duration].
+ * \param settings  lattice spacing, time step, speed limit.
+ * \throws std::invalid_argument naming a setting out of range, or when the
+ *         lattice would have more than 100000 views.
+ */
+[[nodiscard]] HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& wMc_start,
+                                           double r_sphere, double duration, const HindsightSettings& settings);
+
+}  // namespace ofv::sim
