@@ -156,7 +156,9 @@ bool may_change(const Changes& ch, const Eigen::Vector3d& o) {
   });
 }
 
-void check(const HindsightSettings& s, double r_sphere, double duration, double rate) {
+}  // namespace
+
+void check_hindsight(const HindsightSettings& s, double r_sphere, double duration, double rate) {
   if (!(std::isfinite(s.spacing) && s.spacing > 0.0)) {
     throw std::invalid_argument("setting 'hindsight_spacing' must be a positive length, got " + format_number(s.spacing));
   }
@@ -190,11 +192,9 @@ void check(const HindsightSettings& s, double r_sphere, double duration, double 
   }
 }
 
-}  // namespace
-
 HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& wMc_start, double r_sphere,
                              double duration, const HindsightSettings& settings) {
-  check(settings, r_sphere, duration, scenario.rate);
+  check_hindsight(settings, r_sphere, duration, scenario.rate);
   const auto started = std::chrono::steady_clock::now();
   HindsightPlan plan;
   const double frame = 1.0 / scenario.rate;

@@ -79,5 +79,46 @@ TEST(Reports, TablesHaveThePerceptionScores) {
   std::filesystem::remove_all(dir);
 }
 
+// With a hindsight variant in the sweep, every variant's distance to it,
+// seed by seed, in both tables; without one, no such columns.
+TEST(Reports, TablesShowTheDistanceToTheLimit) {
+  const auto dir = std::filesystem::temp_directory_path() / ("ofv_reports_limit_" + std::to_string(::getpid()));
+  std::vector<EpisodeRow> rows(4);
+  const double visible[4] = {0.8, 0.9, 0.95, 1.0};  // variant a on seeds 0, 1; the limit on seeds 0, 1
+  const double below[4] = {1.0, 0.5, 0.2, 0.0};
+  for (int k = 0; k < 4; ++k) {
+    rows[k].spec.scenario = "one";
+    rows[k].spec.variant = {k < 2 ? "a" : "limit", {{"method", k < 2 ? "estimator" : "hindsight"}}};
+    rows[k].spec.seed = static_cast<unsigned>(k % 2);
+    rows[k].spec.index = k;
+    rows[k].metrics.mean_visible_fraction = visible[k];
+    rows[k].metrics.time_below_threshold = below[k];
+    if (k >= 2) rows[k].metrics.hindsight = HindsightBound{visible[k] + 0.001, 1.0};
+  }
+  write_tables(rows, dir.string());
+  std::ifstream summary(dir / "summary.csv");
+  std::string header, a, limit;
+  std::getline(summary, header);
+  std::getline(summary, a);
+  std::getline(summary, limit);
+  EXPECT_NE(header.find(",to_limit_visible_fraction,to_limit_visible_fraction_ci95,"), std::string::npos) << header;
+  EXPECT_NE(header.find(",hindsight_bound,"), std::string::npos) << header;
+  // a - limit: (0.8 - 0.95 + 0.9 - 1.0) / 2 = -0.125; below 0.9: (0.8 + 0.5) / 2 = 0.65; the limit's own: 0.
+  EXPECT_NE(a.find(",-0.125,"), std::string::npos) << a;
+  EXPECT_NE(a.find(",0.65,"), std::string::npos) << a;
+  EXPECT_NE(limit.find(",0,0,0,0"), std::string::npos) << limit;
+  std::ifstream md(dir / "summary.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("to limit: visible"), std::string::npos);
+  EXPECT_NE(text.find("-0.125"), std::string::npos);
+
+  rows.resize(2);  // no limit
+  write_tables(rows, dir.string());
+  std::ifstream without(dir / "summary.csv");
+  std::getline(without, header);
+  EXPECT_EQ(header.find("to_limit"), std::string::npos) << header;
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace ofv

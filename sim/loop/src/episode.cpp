@@ -166,6 +166,13 @@ void record_step(StepRecord& rec, const servo::LoopStep& step) {
   for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = step.velocity[i];
 }
 
+// Method hindsight's planner: the setup's lattice and step, the loop's speed limit.
+sim::HindsightSettings planner_settings(const EpisodeSetup& setup) {
+  sim::HindsightSettings h = setup.hindsight;
+  h.max_speed = setup.loop.controller.max_linear_speed;
+  return h;
+}
+
 // The number of frames of an episode, checked before it becomes an integer
 // (a setup made in code skips the settings' bounds).
 long episode_frames(const EpisodeSetup& setup) {
@@ -229,6 +236,9 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
                                 " s old when its command is sent, older than stale_timeout, and the robot would "
                                 "never move; lower latency or raise stale_timeout");
   }
+  if (s.loop.method == ViewMethod::Hindsight) {
+    sim::check_hindsight(planner_settings(s), s.loop.estimator.resolve().r_sphere, s.duration, s.scenario.rate);
+  }
   if (s.real_time && s.robot == servo::RobotKind::Camera) {
     throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");
   }
@@ -252,9 +262,8 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   std::optional<sim::HindsightPlan> plan;
   double lead = 0.0;
   if (setup.loop.method == ViewMethod::Hindsight) {
-    sim::HindsightSettings h = setup.hindsight;
-    h.max_speed = setup.loop.controller.max_linear_speed;
-    plan = sim::plan_hindsight(scenario, scenario.wMc_start, loop.estimator().r_sphere, setup.duration, h);
+    plan = sim::plan_hindsight(scenario, scenario.wMc_start, loop.estimator().r_sphere, setup.duration,
+                               planner_settings(setup));
     const servo::ControllerSettings& c = setup.loop.controller;
     lead = dt * setup.latency + 1.0 / (c.adaptive_gain ? 2.0 * c.gain : c.gain);
   }

@@ -64,6 +64,15 @@ struct HindsightPlan {
 };
 
 /**
+ * \brief Checks the planner's settings for an episode (plan_hindsight() does too).
+ * \throws std::invalid_argument naming the setting (hindsight_spacing,
+ *         hindsight_step) and the value: out of range, a spacing larger than
+ *         the camera's move in one step (it could never move), or more than
+ *         100000 views.
+ */
+void check_hindsight(const HindsightSettings& settings, double r_sphere, double duration, double rate);
+
+/**
  * \brief Plans the best camera path of an episode in hindsight.
  * \param scenario  the world (already varied for its seed).
  * \param wMc_start the camera's pose at time 0 (its orientation sets the
@@ -71,8 +80,7 @@ struct HindsightPlan {
  * \param r_sphere  the sphere's radius [m].
  * \param duration  the episode's length [s]; steps cover [0, duration].
  * \param settings  lattice spacing, time step, speed limit.
- * \throws std::invalid_argument naming a setting out of range, or when the
- *         lattice would have more than 100000 views.
+ * \throws std::invalid_argument as check_hindsight().
  */
 [[nodiscard]] HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& wMc_start,
                                            double r_sphere, double duration, const HindsightSettings& settings);
