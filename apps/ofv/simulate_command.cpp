@@ -179,7 +179,10 @@ Command add_simulate_command(CLI::App& app) {
               }
 #endif
               std::cout << "ofv simulate: " << setup.scenario.name << ", robot " << to_string(setup.robot) << ", "
-                        << to_string(setup.loop.method) << ", perception " << to_string(setup.perception) << '\n'
+                        << to_string(setup.loop.method)
+                        << (setup.loop.method == ViewMethod::Hindsight ? std::string(" (no perception: the plan)")
+                                                                       : ", perception " + std::string(to_string(setup.perception)))
+                        << '\n'
                         << episode_summary(outcome.metrics) << "  wrote " << written.size() << " files in " << dir.string()
                         << " (trajectory.csv, metrics.json ...)";
               if (!opt->record.empty()) std::cout << "; frames recorded in " << opt->record;

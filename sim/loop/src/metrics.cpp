@@ -220,6 +220,13 @@ std::string episode_summary(const EpisodeMetrics& m) {
     score("centroid error [cm]", p.centroid_error, 100.0);
     score(", hidden part [cm]", p.hidden_error, 100.0);
   }
+  if (m.hindsight) {
+    const HindsightBound& h = *m.hindsight;
+    out << "\n  limit (hindsight): planned " << h.planned << ", followed " << m.mean_visible_fraction
+        << ", without a speed limit " << h.unlimited << "; " << h.views << " views x " << h.steps << " steps, "
+        << h.evaluations << " evaluations, planned in " << std::setprecision(1) << h.plan_s << " s"
+        << std::setprecision(3);
+  }
   out << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path " << m.path_length
       << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
       << "  compute per step: " << 1e3 * m.mean_times.total() << " ms (render " << 1e3 * m.mean_times.render
