@@ -287,14 +287,17 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       evaluate.push_back(v);
       poses.push_back(looking_at(o, c[si], wMc_start));
     }
+    // At time 0 the camera is as the scenario puts it (the object may be
+    // off its image); from the first step on it is taken to look at the centroid.
     for (int j = 0; j <= std::min<long>(chain, i); ++j) {
       const Eigen::Vector3d& o = a[static_cast<std::size_t>(j)];
-      if (j < i && !may_change(changes, o)) {
+      const bool aimed_before = j < i && !(i == 1 && j == 0);
+      if (aimed_before && !may_change(changes, o)) {
         value[si][static_cast<std::size_t>(n + j)] = value[si - 1][static_cast<std::size_t>(n + j)];
         continue;
       }
       evaluate.push_back(n + j);
-      poses.push_back(looking_at(o, c[si], wMc_start));
+      poses.push_back(i == 0 ? wMc_start : looking_at(o, c[si], wMc_start));
     }
     if (poses.empty()) {
       plan.best_visible.push_back(plan.best_visible.back());

@@ -70,8 +70,9 @@ TEST(Hindsight, NothingInTheWayKeepsTheCameraWhereItIs) {
   const HindsightPlan p = plan_hindsight(s, s.wMc_start, 0.5, s.duration, h);
   EXPECT_EQ(p.bound, 1.0);
   for (const Eigen::Vector3d& v : p.views) EXPECT_LT((v - s.wMc_start.translation()).norm(), 1e-12);
-  // Nothing moves: every view is scored once, at the start, and kept.
-  EXPECT_EQ(p.evaluations, p.lattice_views + 1);
+  // Nothing moves: every view is scored once, at the start, and kept; the
+  // start twice (as placed at time 0, then looking at the centroid).
+  EXPECT_EQ(p.evaluations, p.lattice_views + 2);
 }
 
 // What the plan says it sees is what the renderer sees from there (the
