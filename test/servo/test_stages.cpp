@@ -12,6 +12,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
 namespace ofv::servo {
@@ -183,6 +184,31 @@ TEST(ViewLoop, OneFrameMovesWithTheSceneAndTheCommandDoesNot) {
     EXPECT_EQ(s.status, ref.status);
     for (unsigned i = 0; i < 6; ++i) EXPECT_NEAR(s.velocity[i], ref.velocity[i], 1e-9) << i;
   }
+}
+
+// Method hindsight: follow() is the controller and the safety filter alone,
+// towards the view it is given; step() refuses the method.
+TEST(ViewLoop, FollowDrivesToTheGivenViewThroughTheSafetyFilter) {
+  LoopSettings settings;
+  settings.method = ViewMethod::Hindsight;
+  ViewLoop loop(settings);
+  EXPECT_THROW((void)loop.step(Observation{}, 1.0 / 30.0), std::logic_error);
+  // The camera at the origin looking at C = (0, 0, 0.5); the view 0.1 m to its right on the sphere.
+  const Eigen::Vector3d centroid(0.0, 0.0, 0.5);
+  const Eigen::Vector3d view = centroid + 0.5 * Eigen::Vector3d(0.2, 0.0, -1.0).normalized();
+  const LoopStep s = loop.follow(view, centroid, Eigen::Isometry3d::Identity(), 1.0 / 30.0, 1.0 / 30.0);
+  EXPECT_EQ(s.status, StepStatus::Planned);
+  EXPECT_EQ(s.proposer, Proposer::Plan);
+  EXPECT_EQ(s.mode, LoopMode::Pursue);
+  ASSERT_TRUE(s.target);
+  EXPECT_EQ(*s.target, view);
+  EXPECT_GT(s.velocity[0], 0.0);  // towards +x, in the camera frame (the camera is the world here)
+  // From rest, within the acceleration limit.
+  EXPECT_LE(std::hypot(s.velocity[0], s.velocity[1], s.velocity[2]),
+            settings.safety.max_linear_accel / 30.0 + 1e-9);
+  // A frame older than the stale timeout: no motion.
+  const LoopStep stale = loop.follow(view, centroid, Eigen::Isometry3d::Identity(), 10.0, 1.0 / 30.0);
+  EXPECT_EQ(stale.velocity.frobeniusNorm(), 0.0);
 }
 
 }  // namespace

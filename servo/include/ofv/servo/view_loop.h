@@ -216,6 +216,7 @@ class ViewLoop {
    *                  the command is sent (older than the stale timeout: stop).
    * \param dt        time since the previous frame, and the period the command
    *                  will be applied for [s].
+   * \throws std::logic_error with method hindsight, which follow() drives.
    */
   [[nodiscard]] LoopStep step(const Observation& observation, double dt);
 
