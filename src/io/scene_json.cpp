@@ -235,6 +235,58 @@ Scene scene_from_json(const json& j, const std::string& source) {
   return scene;
 }
 
+namespace {
+
+// What scene_from_text() checks before parsing: containers nested at most
+// kMaxSceneDepth deep, no key twice in one object. Linear in the text.
+class SceneChecks final : public nlohmann::json_sax<json> {
+ public:
+  bool null() override { return true; }
+  bool boolean(bool /*value*/) override { return true; }
+  bool number_integer(number_integer_t /*value*/) override { return true; }
+  bool number_unsigned(number_unsigned_t /*value*/) override { return true; }
+  bool number_float(number_float_t /*value*/, const string_t& /*text*/) override { return true; }
+  bool string(string_t& /*value*/) override { return true; }
+  bool binary(binary_t& /*value*/) override { return true; }
+  bool start_object(std::size_t /*size*/) override {
+    keys_.emplace_back();
+    return enter();
+  }
+  bool key(string_t& name) override {
+    if (keys_.back().insert(name).second) return true;
+    problem = "duplicate key \"" + clip(name) + "\"";
+    return false;
+  }
+  bool end_object() override {
+    keys_.pop_back();
+    --depth_;
+    return true;
+  }
+  bool start_array(std::size_t /*size*/) override { return enter(); }
+  bool end_array() override {
+    --depth_;
+    return true;
+  }
+  // A syntax error is reported by the parse that follows.
+  bool parse_error(std::size_t /*position*/, const std::string& /*token*/,
+                   const nlohmann::detail::exception& /*error*/) override {
+    return false;
+  }
+
+  std::string problem;  ///< why the check stopped, empty for a syntax error
+
+ private:
+  bool enter() {
+    if (++depth_ <= kMaxSceneDepth) return true;
+    problem = "nested deeper than " + std::to_string(kMaxSceneDepth) + " levels";
+    return false;
+  }
+  int depth_ = 0;
+  std::vector<std::set<std::string>> keys_;  // of the objects being read
+};
+
+}  // namespace
+
 Scene read_scene(const std::string& path) {
   return scene_from_text(read_text_file(path, kMaxSceneBytes, "scene"), path);
 }
@@ -244,32 +296,19 @@ Scene scene_from_text(const std::string& text, const std::string& source) {
     throw std::invalid_argument(source + ": " + std::to_string(text.size()) + " bytes, more than " +
                                 std::to_string(kMaxSceneBytes));
   }
-  // The parser's callback sees every value as it is read: nesting deeper than
-  // kMaxSceneDepth and a key repeated in one object stop the parse there.
-  std::vector<std::set<std::string>> keys;  // of the objects being read
-  std::string problem;
-  const json::parser_callback_t check = [&](int depth, json::parse_event_t event, json& parsed) {
-    if (depth > kMaxSceneDepth) {
-      problem = "nested deeper than " + std::to_string(kMaxSceneDepth) + " levels";
-      throw std::invalid_argument(problem);
-    }
-    if (event == json::parse_event_t::object_start) {
-      keys.emplace_back();
-    } else if (event == json::parse_event_t::object_end) {
-      keys.pop_back();
-    } else if (event == json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second) {
-      problem = "duplicate key \"" + clip(parsed.get<std::string>()) + "\"";
-      throw std::invalid_argument(problem);
-    }
-    return true;
-  };
+  // The text is checked before it is parsed: nesting deeper than
+  // kMaxSceneDepth and a key repeated in one object stop the check there.
+  // (nlohmann's parse with a callback would do it in one pass, but it scans
+  // the enclosing array at every object's end: quadratic in the supervoxels.)
+  SceneChecks checks;
+  if (!json::sax_parse(text, &checks) && !checks.problem.empty()) {
+    throw std::invalid_argument(source + ": invalid JSON: " + checks.problem);
+  }
   json j;
   try {
-    j = json::parse(text, check);
+    j = json::parse(text);
   } catch (const json::exception& e) {  // syntax errors and number overflow (1e999)
     throw std::invalid_argument(source + ": invalid JSON: " + clip(e.what()));
-  } catch (const std::invalid_argument&) {
-    throw std::invalid_argument(source + ": invalid JSON: " + problem);
   }
   return scene_from_json(j, source);
 }
