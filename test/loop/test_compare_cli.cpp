@@ -180,6 +180,35 @@ TEST_F(SweepCli, MergeRefusesOtherSweepsAndConflictsAndNamesWhatIsMissing) {
 }
 
 
+// A part whose trajectory files were cut short or lost since: the merge
+// refuses it naming the file; running the part again runs those episodes again.
+TEST_F(SweepCli, MergeRefusesDamagedTrajectoriesAndResumeRunsThemAgain) {
+  const std::string grid = sh(write("g.yaml", kShort + "seeds: 2\nvariants:\n  - {name: fast, set: {gain: 2}}\n").string());
+  const auto part = [&](const std::string& shard, const std::string& name) {
+    return run("compare --scenarios dvd-one-hand --grid " + grid + " --jobs 1 --shard " + shard + " --out " +
+               sh((dir_ / name).string()));
+  };
+  ASSERT_EQ(part("1/2", "p1").code, 0);
+  ASSERT_EQ(part("2/2", "p2").code, 0);
+  fs::path csv;
+  for (const auto& e : fs::directory_iterator(dir_ / "p2" / "episodes")) {
+    if (e.path().extension() == ".csv") csv = e.path();
+  }
+  ASSERT_FALSE(csv.empty());
+  const std::string merge = "--merge " + sh((dir_ / "p1").string()) + " " + sh((dir_ / "p2").string()) + " --out ";
+  fs::resize_file(csv, fs::file_size(csv) / 2);
+  expect_usage_error(merge + sh((dir_ / "m1").string()), {csv.string(), "cut short"});
+  fs::remove(csv);
+  expect_usage_error(merge + sh((dir_ / "m2").string()), {csv.string(), "missing"});
+  EXPECT_FALSE(fs::exists(dir_ / "m1"));
+  const CommandRun again = part("2/2", "p2");
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("(1 run, 0 resumed)"), std::string::npos) << again.out;
+  const CommandRun ok = run("compare " + merge + sh((dir_ / "m3").string()));
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(lines(dir_ / "m3" / "episodes.csv"), 3U);
+}
+
 TEST_F(SweepCli, DryRunListsThePartAndSlurmScriptWritesTheJobs) {
   const std::string grid = sh(write("g.yaml", kShort + "seeds: 2\nvariants:\n  - {name: fast, set: {gain: 2}}\n"
                                                        "  - {name: slow, set: {gain: 1}}\n").string());

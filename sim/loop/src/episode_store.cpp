@@ -233,6 +233,27 @@ std::pair<EpisodeSpec, json> read_episode(const fs::path& file) {
   }
 }
 
+// What is wrong with the trajectory file of a finished episode of `steps`
+// steps (its header and one row per step), or nothing.
+std::string trajectory_problem(const fs::path& csv, int steps) {
+  std::error_code ec;
+  if (!fs::is_regular_file(csv, ec)) return "missing";
+  std::ifstream in(csv, std::ios::binary);
+  long lines = 0;
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) lines += std::count(buffer, buffer + in.gcount(), '\n');
+  if (lines == steps + 1L) return {};
+  return "cut short or grown: " + std::to_string(std::max(0L, lines - 1)) + " rows for " + std::to_string(steps) + " steps";
+}
+
+int steps_of(const json& episode) {
+  try {
+    return episode.at("metrics").at("steps").get<int>();
+  } catch (const json::exception&) {
+    return -1;
+  }
+}
+
 }  // namespace
 
 void write_file_atomically(const fs::path& path, const std::string& text) {
@@ -289,9 +310,11 @@ EpisodeStore::EpisodeStore(const std::string& out_dir, const std::vector<Episode
 bool EpisodeStore::finished(const EpisodeSpec& spec) const {
   const fs::path file = dir_ / (spec.id() + ".json");
   if (!fs::exists(file)) return false;
-  const std::string diff = episode_difference(read_episode(file).first, spec);
+  const auto [recorded, j] = read_episode(file);
+  const std::string diff = episode_difference(recorded, spec);
   if (!diff.empty()) throw std::invalid_argument(file.string() + ": another episode (" + diff + ")");
-  return true;
+  // A trajectory missing or damaged since: the episode runs again.
+  return trajectory_problem(dir_ / (spec.id() + ".csv"), steps_of(j)).empty();
 }
 
 void EpisodeStore::write(const EpisodeSpec& spec, const EpisodeOutcome& outcome) const {
@@ -380,6 +403,10 @@ SweepEpisodes read_sweep(const std::vector<std::string>& dirs) {
         throw std::invalid_argument(f.string() + ": not a finished episode of this folder: " + e.what());
       }
       row.trajectory_csv = (dir / (spec.id() + ".csv")).string();
+      if (const std::string why = trajectory_problem(row.trajectory_csv, row.metrics.steps); !why.empty()) {
+        throw std::invalid_argument(row.trajectory_csv + ": the trajectory of a finished episode is " + why +
+                                    ": run its part again (ofv compare with the same --out runs it again)");
+      }
       found.insert(spec.id());
       out.rows.push_back(row);
     }
