@@ -137,7 +137,7 @@ struct Renderer::Impl {
     // Rays from the camera to the samples it may see, 8 to a packet.
     constexpr int kPacket = 8;
     alignas(32) int valid[kPacket];
-    RTCRay8 ray;
+    RTCRay8 ray{};  // lanes past the last sample stay zero (and invalid)
     for (int j = 0; j < kPacket; ++j) {
       ray.org_x[j] = static_cast<float>(o.x());
       ray.org_y[j] = static_cast<float>(o.y());
