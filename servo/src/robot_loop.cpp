@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <deque>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -142,8 +141,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
 
   RobotLoopSummary summary;
   long watchdog_stops = 0;       // as of the previous frame
-  int bad_in_row = 0;
-  std::deque<Clock::time_point> bad_times;  // of the bad frames of the last minute
+  BadFrameBudget bad_frames(options.max_bad_frames_in_row, options.max_bad_frames_per_minute);
   try {
     std::optional<double> first_stamp, last_stamp;
     while (options.stop == nullptr || *options.stop == 0) {
@@ -189,14 +187,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       if (!out.bad_frame.empty()) {
         // Skipped with a stop; the loop keeps its state for the next frame.
         ++summary.bad_frames;
-        bad_times.push_back(arrived);
-        while (arrived - bad_times.front() > std::chrono::minutes(1)) bad_times.pop_front();
-        const bool in_a_row = ++bad_in_row > options.max_bad_frames_in_row;
-        if (in_a_row || static_cast<long>(bad_times.size()) > options.max_bad_frames_per_minute) {
-          throw std::runtime_error((in_a_row ? std::to_string(bad_in_row) + " bad frames in a row"
-                                             : std::to_string(bad_times.size()) + " bad frames in a minute") +
-                                   ", the last: " + out.bad_frame);
-        }
+        bad_frames.bad(arrived, out.bad_frame);
         loop.robot_stopped();
         observation.wMc = to_eigen(watchdog.pose());
         LoopStep skipped;
@@ -211,7 +202,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
         if (on_frame) on_frame(out);
         continue;
       }
-      bad_in_row = 0;
+      bad_frames.good();
       observation.wMc = frame->wMc;
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       observation.age = out.frame_age = options.wall_clock_age ? out.perception_s : gap;

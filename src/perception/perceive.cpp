@@ -10,10 +10,6 @@
 
 namespace ofv::perception {
 
-namespace {
-constexpr int kMaxBadFramesInRow = 10;
-}  // namespace
-
 PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
                          const EstimatorSettings& settings, long max_frames,
                          const std::function<void(const PerceivedFrame&)>& observer) {
@@ -31,12 +27,12 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
       &PerceiveSummary::occluder_recall, &PerceiveSummary::centroid_error};
   double sum[kScores] = {};
   long count[kScores] = {};
-  int bad_in_row = 0;
+  BadFrameBudget bad_frames(kMaxBadFramesInRow, kMaxBadFramesPerMinute);
   while (max_frames < 0 || summary.frames < max_frames) {
     PerceivedFrame f;
     // A frame the source cannot read (BadFrame) or the front end refuses is
     // skipped and counted; a broken recording (the source's
-    // std::invalid_argument) or many bad frames in a row end the run.
+    // std::invalid_argument) or too many bad frames (BadFrameBudget) end the run.
     std::string bad;
     try {
       std::optional<RgbdFrame> frame = source.next();
@@ -53,12 +49,10 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     if (!bad.empty()) {
       ++summary.bad_frames;
       summary.last_bad_frame = bad.substr(0, bad.find('\n'));
-      if (++bad_in_row > kMaxBadFramesInRow) {
-        throw std::runtime_error(std::to_string(bad_in_row) + " bad frames in a row, the last: " + summary.last_bad_frame);
-      }
+      bad_frames.bad(BadFrameBudget::Clock::now(), summary.last_bad_frame);
       continue;
     }
-    bad_in_row = 0;
+    bad_frames.good();
     f.index = summary.frames;
     front_end_ms.push_back(f.result.timings.total);
     if (f.result.status != TrackingStatus::Lost) {

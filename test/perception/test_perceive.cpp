@@ -87,6 +87,19 @@ TEST(Perceive, AFrameThatFailsItsChecksIsSkippedAndCountedManyInARowEndTheRun) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("11 bad frames in a row"), std::string::npos) << e.what();
   }
+  // Never two in a row, but 31 within a minute.
+  std::vector<RgbdFrame> every_other;
+  for (int k = 0; k < 31; ++k) {
+    every_other.push_back(frames[0]);
+    every_other.push_back(short_read);
+  }
+  VectorSource often_bad(every_other);
+  try {
+    (void)perceive_all(often_bad, -1);
+    ADD_FAILURE() << "31 bad frames in a minute went on";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("31 bad frames in a minute"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {

@@ -51,7 +51,8 @@ struct PerceiveSummary {
   long lost = 0;    ///< of those, frames in which the object was lost (no estimate)
   /// Frames skipped: the source could not read them (ofv::BadFrame) or the
   /// front end refused them (std::invalid_argument); not in `frames`, not
-  /// given to the observer. More than 10 in a row end the run (std::runtime_error).
+  /// given to the observer. More than ofv::kMaxBadFramesInRow in a row, or
+  /// ofv::kMaxBadFramesPerMinute within a minute, end the run (std::runtime_error).
   long bad_frames = 0;
   std::string last_bad_frame;  ///< why the last skipped frame was skipped
   /// Median of the front end's total time per frame (PerceptionTimings::total)

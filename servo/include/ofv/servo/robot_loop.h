@@ -46,9 +46,9 @@ struct RobotLoopOptions {
   /// observer refuses (std::invalid_argument: a depth image of the wrong
   /// size, a pose that is not a rigid transform, ...) is skipped with a
   /// stop; the run ends after more than this many in a row ...
-  int max_bad_frames_in_row = 10;
+  int max_bad_frames_in_row = kMaxBadFramesInRow;
   /// ... or more than this many in the last 60 s.
-  int max_bad_frames_per_minute = 30;
+  int max_bad_frames_per_minute = kMaxBadFramesPerMinute;
   /// When set, stop as soon as it reads non-zero (a signal handler's flag).
   const volatile std::sig_atomic_t* stop = nullptr;
 };
