@@ -11,6 +11,7 @@
 #include "ofv/sources/open_source.h"
 #include "ofv/sources/openni2_source.h"
 
+#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
@@ -125,11 +126,16 @@ Command add_perceive_command(CLI::App& app) {
               return kUsage;
             }
 
+            // `ofv perceive ... | head`: a line that cannot be written (EPIPE,
+            // SIGPIPE ignored) ends the run cleanly, saying why.
+            struct ReaderGone {};
+            std::signal(SIGPIPE, SIG_IGN);
             try {
               const perception::PerceiveSummary summary = perception::perceive(
                   *source, ps, settings, opt->max_frames, [&](const perception::PerceivedFrame& f) {
                     if (opt->out.empty()) {
-                      std::cout << perception::perceived_frame_json(f, params) << '\n';
+                      std::cout << perception::perceived_frame_json(f, params) << '\n' << std::flush;
+                      if (!std::cout) throw ReaderGone{};
                     } else {
                       perception::write_perceived_frame(opt->out, f, params, opt->pictures, settings.r_sphere);
                     }
@@ -153,6 +159,9 @@ Command add_perceive_command(CLI::App& app) {
                           << show(summary.occluder_precision) << ", recall " << show(summary.occluder_recall)
                           << "; centroid error " << show(summary.centroid_error, 100.0) << " cm\n";
               }
+              return kOk;
+            } catch (const ReaderGone&) {
+              std::cerr << "ofv perceive: stopped: the output's reader went away\n";
               return kOk;
             } catch (const std::invalid_argument& e) {
               std::cerr << "ofv perceive: " << e.what() << '\n';

@@ -110,6 +110,35 @@ TEST(PerceiveCli, ARecordingWithLabelsIsScored) {
   EXPECT_TRUE(j["scores"]["occluder_recall"].is_null());
 }
 
+TEST(PerceiveCli, AClosedOutputEndsTheRunCleanly) {
+  // `ofv perceive REC | head -1`: the reader goes away after one line; the
+  // next line fails (EPIPE, not a SIGPIPE kill) and the run ends, exit 0.
+  const fs::path dir = fs::path(test::scratch_dir()) / "ofv_perceive_pipe";
+  fs::remove_all(dir);
+  {
+    TumSequenceWriter writer(dir.string());
+    const std::vector<RgbdFrame> frames = episode();
+    for (int k = 0; k < 60; ++k) {
+      RgbdFrame f = frames[static_cast<std::size_t>(k % 4)];
+      f.timestamp = k / 30.0;
+      writer.write(f);
+    }
+  }
+  const std::string err = (fs::path(test::scratch_dir()) / "perceive_pipe.err").string();
+  const std::string command = std::string("bash -c '") + OFV_BINARY + " perceive " + dir.string() + " 2>" + err +
+                              " | head -1 >/dev/null; echo ${PIPESTATUS[0]}'";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string status;
+  char buffer[256];
+  for (std::size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) status.append(buffer, n);
+  pclose(pipe);
+  EXPECT_EQ(status, "0\n");
+  std::ifstream in(err);
+  const std::string said((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(said.find("stopped: the output's reader went away"), std::string::npos) << said;
+}
+
 TEST(PerceiveCli, OniRecordingStreamsJsonLines) {
   const fs::path oni = fs::path(test::scratch_dir()) / "ofv_perceive.oni";
   {
