@@ -15,12 +15,16 @@
  * when the camera travels at most max_speed x the step between the two
  * positions. Dynamic programming over (step, view) gives the path with the
  * largest sum of values: exact for the lattice and the steps, not a
- * heuristic search. The camera starts where the scenario puts it; off its
+ * heuristic search. The camera starts where and as the scenario puts it
+ * (from the first step on it is taken to look at the centroid); off its
  * sphere, it first reaches the sphere along the radius at full speed.
  *
- * The cost is views x steps visibility evaluations (each ray casts the
- * object's surface samples that face the view) plus views x neighbours x
- * steps for the programme; HindsightPlan records both counts and the time.
+ * The cost is at most views x steps visibility evaluations (each ray casts
+ * the object's surface samples that face the view) plus views x neighbours
+ * x steps for the programme. A view whose cone of sight to the object no
+ * moving body came near since the last step keeps its value, so a still
+ * scene costs one step's evaluations. HindsightPlan records the views, the
+ * evaluations made and the planning time.
  */
 #pragma once
 
