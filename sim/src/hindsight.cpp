@@ -24,8 +24,8 @@ namespace {
 
 constexpr double kUnreached = -std::numeric_limits<double>::infinity();
 constexpr int kMaxViews = 100000;
-constexpr double kPiece = 0.04;
-constexpr double kOnSphere = 1e-3;  // a camera this close to its sphere is on it [m]  // size of the pieces of a moving body tested against a view's cone [m]
+constexpr double kPiece = 0.04;     // size of the pieces of a moving body tested against a view's cone [m]
+constexpr double kOnSphere = 1e-3;  // a camera this close to its sphere is on it [m]
 
 // The camera at `position` looking at `centroid`, turned from `start` by the least rotation.
 Eigen::Isometry3d looking_at(const Eigen::Vector3d& position, const Eigen::Vector3d& centroid,
@@ -216,8 +216,7 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     }
     before = std::move(now);
   }
-  Renderer renderer(scenario);
-  renderer.set_time(0.0);
+  Renderer renderer(scenario);  // at time 0
   std::vector<Eigen::Vector3d> c(static_cast<std::size_t>(steps), renderer.object_centroid());
 
   const int n = std::max(1, static_cast<int>(std::lround(4.0 * kPi * r_sphere * r_sphere / (settings.spacing * settings.spacing))));
