@@ -220,36 +220,18 @@ TEST(OneLoop, AClosedOutputStopsTheRunCleanly) {
   // `ofv run --dry-run | head -1`: the reader goes away after one line; the
   // next line fails (EPIPE, not a SIGPIPE kill), the run stops as on a
   // signal, leaves the robot at rest and exits 0, saying why on stderr.
-  const std::string err = (fs::path(test::scratch_dir()) / "closed_output.err").string();
-  const std::string command = std::string("bash -c '") + OFV_BINARY +
-                              " run --robot afma6 --source sim:dvd-one-hand --set duration=30 --dry-run 2>" + err +
-                              " | head -1 >/dev/null; echo ${PIPESTATUS[0]}'";
   const auto start = std::chrono::steady_clock::now();
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string status;
-  char buffer[256];
-  for (std::size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) status.append(buffer, n);
-  pclose(pipe);
-  EXPECT_EQ(status, "0\n");
+  const CommandRun r = run_into_head("run --robot afma6 --source sim:dvd-one-hand --set duration=30 --dry-run");
+  EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 20.0);
-  std::ifstream in(err);
-  const std::string said((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(said.find("stopped: the output's reader went away"), std::string::npos) << said;
+  EXPECT_NE(r.err.find("stopped: the output's reader went away"), std::string::npos) << r.err;
 }
 
 TEST(OneLoop, SignalsStopTheRobotAndEndTheRun) {
   for (const char* signal : {"INT", "TERM"}) {
     // Like Ctrl-C (INT) or a kill (TERM) 4 s into a 30 s run (start-up included: slow under sanitizers).
-    CommandRun r;
-    const std::string command = std::string("timeout --preserve-status -s ") + signal + " 4 " + OFV_BINARY +
-                                " run --robot afma6 --source sim:dvd-one-hand --set duration=30 --dry-run 2>/dev/null";
-    FILE* pipe = popen(command.c_str(), "r");
-    ASSERT_NE(pipe, nullptr);
-    char buffer[4096];
-    for (std::size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.out.append(buffer, n);
-    const int status = pclose(pipe);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const CommandRun r = shell(std::string("timeout --preserve-status -s ") + signal + " 4 " + OFV_BINARY +
+                               " run --robot afma6 --source sim:dvd-one-hand --set duration=30 --dry-run 2>/dev/null");
     EXPECT_EQ(r.code, 0) << signal << ": " << r.err;
     const std::vector<Command> commands = dry_run_commands(r.out.substr(0, r.out.find("ofv run:")));
     ASSERT_FALSE(commands.empty()) << signal;

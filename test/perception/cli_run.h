@@ -22,11 +22,9 @@ struct CommandRun {
   std::string err;
 };
 
-/// Runs `ofv ARGS` (OFV_BINARY) through the shell.
-inline CommandRun run(const std::string& args) {
-  const std::filesystem::path err =
-      std::filesystem::path(test::scratch_dir()) / "ofv_cli_stderr.txt";
-  const std::string command = std::string(OFV_BINARY) + " " + args + " 2>" + err.string();
+/// Runs a shell command: its exit code (-1 if it did not exit normally or
+/// could not start) and stdout; `err` is left empty.
+inline CommandRun shell(const std::string& command) {
   CommandRun r;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) {
@@ -39,10 +37,34 @@ inline CommandRun run(const std::string& args) {
   }
   const int status = pclose(pipe);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err);
+  return r;
+}
+
+/// The text of a file ("" if it cannot be read).
+inline std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
   std::stringstream ss;
   ss << in.rdbuf();
-  r.err = ss.str();
+  return ss.str();
+}
+
+/// Runs `ofv ARGS` (OFV_BINARY) through the shell.
+inline CommandRun run(const std::string& args) {
+  const std::filesystem::path err =
+      std::filesystem::path(test::scratch_dir()) / "ofv_cli_stderr.txt";
+  CommandRun r = shell(std::string(OFV_BINARY) + " " + args + " 2>" + err.string());
+  r.err = file_text(err);
+  return r;
+}
+
+/// `ofv ARGS | head -1`: the reader goes away after the first line. `code`
+/// is ofv's exit status (141 when SIGPIPE killed it), `err` its stderr.
+inline CommandRun run_into_head(const std::string& args) {
+  const std::filesystem::path err =
+      std::filesystem::path(test::scratch_dir()) / "ofv_cli_head_stderr.txt";
+  CommandRun r = shell(std::string("bash -c '") + OFV_BINARY + " " + args + " 2>" + err.string() +
+                       " | head -1 >/dev/null; exit ${PIPESTATUS[0]}'");
+  r.err = file_text(err);
   return r;
 }
 
