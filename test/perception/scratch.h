@@ -4,18 +4,30 @@
 
 #include <gtest/gtest.h>
 
+#include <stdlib.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 namespace ofv::test {
 
-/// The folder, with a trailing slash (like testing::TempDir()).
+/// The folder, with a trailing slash (like testing::TempDir()). It is made
+/// new by mkdtemp: a folder left by an earlier process of the same pid (one
+/// that ended without its destructors) is never reused.
 inline const std::string& scratch_dir() {
   struct Scratch {
-    std::filesystem::path path = std::filesystem::path(testing::TempDir()) / ("ofv_test_" + std::to_string(::getpid()));
-    Scratch() { std::filesystem::create_directories(path); }
+    std::filesystem::path path;
+    Scratch() {
+      std::string pattern =
+          (std::filesystem::path(testing::TempDir()) / ("ofv_test_" + std::to_string(::getpid()) + "_XXXXXX")).string();
+      if (::mkdtemp(pattern.data()) == nullptr)
+        throw std::runtime_error("cannot make a scratch folder " + pattern + ": " + std::strerror(errno));
+      path = pattern;
+    }
     ~Scratch() {
       std::error_code ignored;
       std::filesystem::remove_all(path, ignored);
