@@ -139,10 +139,15 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
   object_points.clear();
   for (const Eigen::Vector3d& p : object_cloud) object_points.push_back(p.cast<float>());
   object_grid.build(object_points, settings.contact_distance);
+  // (Asked only of supervoxels that could be interacting: not object, centre in the box.)
   std::vector<char> touches(n, 0);
+  std::vector<char> asked(n, 0);
+  for (std::size_t i = 0; i < n; ++i) asked[i] = !object[i] && r.obb.contains(r.supervoxels[i].centroid) ? 1 : 0;
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    char& t = touches[static_cast<std::size_t>(r.voxel_owner[i])];
-    t = t || object_grid.any_within(r.voxels[i], static_cast<float>(settings.contact_distance), [](int) { return true; });
+    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    char& t = touches[owner];
+    t = t || (asked[owner] &&
+              object_grid.any_within(r.voxels[i], static_cast<float>(settings.contact_distance), [](int) { return true; }));
   }
 
   // Labels (paper II-B) and the estimator's input. Classes::Labels: the

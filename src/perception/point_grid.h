@@ -18,6 +18,46 @@ inline std::uint64_t cell_key(const Eigen::Vector3i& c) {
   return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
 }
 
+/// Cells (keys of cell_key()) to indices: open addressing, linear probing.
+class CellMap {
+ public:
+  /// Empties the map, sized for `count` keys at most.
+  void reset(std::size_t count) {
+    std::size_t size = 16;
+    while (size < 2 * count) size *= 2;
+    mask_ = size - 1;
+    keys_.assign(size, kEmpty);
+    values_.resize(size);
+  }
+  /// The index stored for `key`, to be set by the caller when it is new (-1).
+  int& find_or_insert(std::uint64_t key) {
+    std::size_t i = slot(key);
+    while (keys_[i] != key && keys_[i] != kEmpty) i = (i + 1) & mask_;
+    if (keys_[i] == kEmpty) {
+      keys_[i] = key;
+      values_[i] = -1;
+    }
+    return values_[i];
+  }
+  /// The index stored for `key`, or -1.
+  [[nodiscard]] int find(std::uint64_t key) const {
+    if (keys_.empty()) return -1;
+    for (std::size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (keys_[i] == key) return values_[i];
+      if (keys_[i] == kEmpty) return -1;
+    }
+  }
+
+ private:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // never a cell_key (63 bits)
+  [[nodiscard]] std::size_t slot(std::uint64_t key) const {
+    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
+  }
+  std::size_t mask_ = 0;
+  std::vector<std::uint64_t> keys_;
+  std::vector<int> values_;
+};
+
 /// Points hashed on a uniform grid: "is any point within r of p" in O(1).
 class PointGrid {
  public:
@@ -33,6 +73,10 @@ class PointGrid {
     }
     std::sort(entries_.begin(), entries_.end(),
               [](const Entry& a, const Entry& b) { return a.key < b.key; });
+    first_.reset(entries_.size());
+    for (std::size_t i = 0; i < entries_.size(); ++i) {
+      if (i == 0 || entries_[i].key != entries_[i - 1].key) first_.find_or_insert(entries_[i].key) = static_cast<int>(i);
+    }
   }
 
   /// True if a point j within `radius` (<= the cell size) of p has accept(j).
@@ -55,11 +99,10 @@ class PointGrid {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const std::uint64_t k = key(c + Eigen::Vector3i(dx, dy, dz));
-          auto it =
-              std::lower_bound(entries_.begin(), entries_.end(), k,
-                               [](const Entry& e, std::uint64_t value) { return e.key < value; });
-          for (; it != entries_.end() && it->key == k; ++it) {
-            f(it->index);
+          const int first = first_.find(k);
+          if (first < 0) continue;
+          for (auto i = static_cast<std::size_t>(first); i < entries_.size() && entries_[i].key == k; ++i) {
+            f(entries_[i].index);
           }
         }
       }
@@ -76,7 +119,8 @@ class PointGrid {
   }
   static std::uint64_t key(const Eigen::Vector3i& c) { return cell_key(c); }
   float inv_cell_ = 1.0f;
-  std::vector<Entry> entries_;
+  std::vector<Entry> entries_;  // sorted by key
+  CellMap first_;               // key -> its first entry
   const std::vector<Eigen::Vector3f>* points_ = nullptr;
 };
 
