@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -15,26 +16,57 @@ namespace {
 
 using detail::chroma;
 
-/// Connected components of the vertices with keep[i], over `edges`.
-std::vector<std::vector<int>> components(std::size_t n,
-                                         const std::vector<std::pair<int, int>>& edges,
-                                         const std::vector<char>& keep) {
+/// Clusters of the supervoxels with keep[i] of one colour: neighbours join,
+/// nearest in chromaticity first, when the two clusters' mean chromaticities
+/// (weighted by voxels) are within max_chroma (any two when max_chroma <= 0).
+/// Comparing clusters, not single supervoxels, keeps a chain of mixed
+/// supervoxels along a border (the case's blue, blue-skin, the hand's skin)
+/// from joining two objects step by small step.
+std::vector<std::vector<int>> colour_clusters(const std::vector<SupervoxelInfo>& supervoxels,
+                                              const std::vector<std::pair<int, int>>& neighbours,
+                                              const std::vector<char>& keep, double max_chroma) {
+  const std::size_t n = supervoxels.size();
   std::vector<int> parent(n);
+  std::vector<Eigen::Vector3f> chroma_sum(n);
+  std::vector<float> weight(n);
   for (std::size_t i = 0; i < n; ++i) {
     parent[i] = static_cast<int>(i);
+    weight[i] = static_cast<float>(std::max(supervoxels[i].voxel_count, 1));
+    chroma_sum[i] = weight[i] * chroma(supervoxels[i].colour);
   }
   const auto find = [&parent](int i) {
     while (parent[static_cast<std::size_t>(i)] != i) {
-      parent[static_cast<std::size_t>(i)] =
-          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
       i = parent[static_cast<std::size_t>(i)];
     }
     return i;
   };
-  for (const auto& [a, b] : edges) {
-    if (keep[static_cast<std::size_t>(a)] && keep[static_cast<std::size_t>(b)]) {
-      parent[static_cast<std::size_t>(find(a))] = find(b);
+  struct Edge {
+    float difference;
+    int a, b;
+  };
+  std::vector<Edge> edges;
+  for (const auto& [a, b] : neighbours) {
+    if (!keep[static_cast<std::size_t>(a)] || !keep[static_cast<std::size_t>(b)]) continue;
+    edges.push_back({(chroma(supervoxels[static_cast<std::size_t>(a)].colour) -
+                      chroma(supervoxels[static_cast<std::size_t>(b)].colour))
+                         .norm(),
+                     std::min(a, b), std::max(a, b)});
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return std::tie(x.difference, x.a, x.b) < std::tie(y.difference, y.a, y.b);
+  });
+  for (const Edge& e : edges) {
+    const auto ra = static_cast<std::size_t>(find(e.a));
+    const auto rb = static_cast<std::size_t>(find(e.b));
+    if (ra == rb) continue;
+    if (max_chroma > 0.0 &&
+        (chroma_sum[ra] / weight[ra] - chroma_sum[rb] / weight[rb]).norm() > static_cast<float>(max_chroma)) {
+      continue;
     }
+    parent[ra] = static_cast<int>(rb);
+    chroma_sum[rb] += chroma_sum[ra];
+    weight[rb] += weight[ra];
   }
   std::vector<int> slot(n, -1);
   std::vector<std::vector<int>> out;
@@ -63,6 +95,19 @@ std::vector<char> select_in_box(const std::vector<SupervoxelInfo>& supervoxels,
   return object;
 }
 
+/// True when p (world frame) projects onto a mask pixel or into the rectangle.
+bool in_image_selection(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
+                        const ObjectSelection& sel) {
+  const auto px = detail::project(frame, cMw, p);
+  if (!px) return false;
+  const int u = static_cast<int>(std::lround(px->x()));
+  const int v = static_cast<int>(std::lround(px->y()));
+  const CameraIntrinsics& k = frame.intrinsics;
+  if (u < 0 || v < 0 || u >= k.width || v >= k.height) return false;
+  if (!sel.mask.empty()) return sel.mask.size() == frame.depth.size() && sel.mask[frame.index(u, v)] != 0;
+  return sel.rect.contains(Eigen::Vector2i(u, v));
+}
+
 /// ObjectSelection::Mode::Image: the supervoxels off the plane whose centroid
 /// projects onto a mask pixel or into the rectangle.
 std::vector<char> select_in_image(const RgbdFrame& frame,
@@ -70,25 +115,8 @@ std::vector<char> select_in_image(const RgbdFrame& frame,
                                   const std::vector<char>& off_plane, const ObjectSelection& sel) {
   std::vector<char> object(supervoxels.size(), 0);
   const Eigen::Isometry3d cMw = frame.wMc.inverse();
-  const CameraIntrinsics& k = frame.intrinsics;
   for (std::size_t i = 0; i < supervoxels.size(); ++i) {
-    if (!off_plane[i]) {
-      continue;
-    }
-    const auto px = detail::project(frame, cMw, supervoxels[i].centroid);
-    if (!px) {
-      continue;
-    }
-    const int u = static_cast<int>(std::lround(px->x()));
-    const int v = static_cast<int>(std::lround(px->y()));
-    if (u < 0 || v < 0 || u >= k.width || v >= k.height) {
-      continue;
-    }
-    if (!sel.mask.empty()) {
-      object[i] = sel.mask.size() == frame.depth.size() && sel.mask[frame.index(u, v)] != 0;
-    } else {
-      object[i] = sel.rect.contains(Eigen::Vector2i(u, v)) ? 1 : 0;
-    }
+    object[i] = off_plane[i] && in_image_selection(frame, cMw, supervoxels[i].centroid, sel) ? 1 : 0;
   }
   return object;
 }
@@ -145,9 +173,43 @@ void grow_into_boundary(const std::vector<SupervoxelInfo>& supervoxels,
   }
 }
 
-/// ObjectSelection::Mode::Auto: the cluster of adjacent, colour-consistent
-/// supervoxels off the plane nearest the image centre, grown into its
-/// boundary supervoxels; none when no cluster is large enough.
+/// The world point seen at the pixel with depth nearest the image centre
+/// (rings of growing radius, within the image); none without depth.
+std::optional<Eigen::Vector3f> centre_point(const RgbdFrame& frame) {
+  const CameraIntrinsics& k = frame.intrinsics;
+  const int cu = k.width / 2, cv = k.height / 2;
+  const int rings = std::max(k.width, k.height);
+  for (int ring = 0; ring <= rings; ++ring) {
+    std::optional<std::pair<int, int>> found;
+    int found_d2 = std::numeric_limits<int>::max();
+    const auto consider = [&](int du, int dv) {
+      const int u = cu + du, v = cv + dv;
+      if (u < 0 || v < 0 || u >= k.width || v >= k.height || du * du + dv * dv >= found_d2) return;
+      const float z = frame.depth[frame.index(u, v)];
+      if (!(z > 0.0f) || !std::isfinite(z)) return;
+      found = {u, v};
+      found_d2 = du * du + dv * dv;
+    };
+    for (int d = -ring; d <= ring; ++d) {  // the ring's pixels: its rows, then the rest of its columns
+      consider(d, -ring);
+      if (ring > 0) consider(d, ring);
+      if (std::abs(d) < ring) {
+        consider(-ring, d);
+        consider(ring, d);
+      }
+    }
+    if (!found) continue;
+    const auto [u, v] = *found;
+    const double z = frame.depth[frame.index(u, v)];
+    const Eigen::Vector3d pc((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z);
+    return (frame.wMc * pc).cast<float>();
+  }
+  return std::nullopt;
+}
+
+/// ObjectSelection::Mode::Auto: of the clusters of adjacent, colour-consistent
+/// supervoxels off the plane, the one the camera points at (centre_point()),
+/// grown into its boundary supervoxels; none when no cluster is large enough.
 std::vector<char> select_cluster(const RgbdFrame& frame, const PerceptionResult& r,
                                  const std::vector<std::pair<int, int>>& touching,
                                  const std::vector<char>& off_plane, const TrackingSettings& t) {
@@ -158,39 +220,29 @@ std::vector<char> select_cluster(const RgbdFrame& frame, const PerceptionResult&
   // adjacency, which also links supervoxels grown larger than R_adj).
   std::vector<std::pair<int, int>> neighbours = r.adjacency;
   neighbours.insert(neighbours.end(), touching.begin(), touching.end());
-  // Clusters grow only across colour-consistent edges: a hand holding the
-  // object in the first frame is adjacent to it but of another colour.
-  std::vector<std::pair<int, int>> edges;
+  // Clusters of one colour: a hand holding the object in the first frame is
+  // adjacent to it but of another colour.
   const double max_chroma = t.max_chroma_distance;
-  for (const auto& [a, b] : neighbours) {
-    if (max_chroma <= 0.0 || (chroma(supervoxels[static_cast<std::size_t>(a)].colour) -
-                              chroma(supervoxels[static_cast<std::size_t>(b)].colour))
-                                     .norm() <= max_chroma) {
-      edges.emplace_back(a, b);
-    }
+  const auto clusters = colour_clusters(supervoxels, neighbours, off_plane, max_chroma);
+  // What the camera points at: the surface seen at the valid pixel nearest
+  // the image centre, and the cluster with a voxel nearest it. (A cluster's
+  // mean would do for a compact object, not for one around another: the
+  // object seen around the hand held in front of it.)
+  const std::optional<Eigen::Vector3f> aim = centre_point(frame);
+  if (!aim) return object;
+  std::vector<int> cluster_of(n, -1);
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    if (static_cast<int>(clusters[c].size()) < t.min_cluster_supervoxels) continue;
+    for (int i : clusters[c]) cluster_of[static_cast<std::size_t>(i)] = static_cast<int>(c);
   }
-  const auto clusters = components(n, edges, off_plane);
-  const Eigen::Isometry3d cMw = frame.wMc.inverse();
-  const CameraIntrinsics& k = frame.intrinsics;
-  double best = std::numeric_limits<double>::infinity();
+  float best = std::numeric_limits<float>::infinity();
   const std::vector<int>* chosen = nullptr;
-  for (const auto& cluster : clusters) {
-    if (static_cast<int>(cluster.size()) < t.min_cluster_supervoxels) {
-      continue;
-    }
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : cluster) {
-      mean += supervoxels[static_cast<std::size_t>(i)].centroid;
-    }
-    mean /= static_cast<double>(cluster.size());
-    const auto px = detail::project(frame, cMw, mean);
-    if (!px) {
-      continue;
-    }
-    const double dist = (*px - Eigen::Vector2d(k.cx, k.cy)).norm();
-    if (dist < best) {
-      best = dist;
-      chosen = &cluster;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    const int c = cluster_of[static_cast<std::size_t>(r.voxel_owner[i])];
+    const float d = (r.voxels[i] - *aim).squaredNorm();
+    if (c >= 0 && d < best) {
+      best = d;
+      chosen = &clusters[static_cast<std::size_t>(c)];
     }
   }
   if (chosen == nullptr) {
@@ -259,11 +311,28 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
     why = if_none;
   }
 
-  // Every voxel of the selection may enter the object state, except the
-  // plane's own under the object's foot.
+  // The voxels of the selection that may enter the object state: not the
+  // plane's own under the object's foot, nor those of a selected supervoxel
+  // whose chromaticity is nearer a touching unselected supervoxel's than
+  // their own supervoxel's. A supervoxel at the object's border can hold a
+  // few voxels of what touches it (a holding hand); remembered, they would
+  // make the hand look like the object in the next frame, and the object
+  // would grow into it.
+  std::vector<std::vector<int>> foreign(n);
+  for (const auto& [a, b] : sv.touching) {
+    const auto ua = static_cast<std::size_t>(a), ub = static_cast<std::size_t>(b);
+    if (object[ua] && !object[ub] && off_plane[ub]) foreign[ua].push_back(b);
+    if (object[ub] && !object[ua] && off_plane[ua]) foreign[ub].push_back(a);
+  }
   voxel_matched.resize(r.voxels.size());
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    voxel_matched[i] = plane_voxel(r.voxels[i], sv.colours[i]) ? 0 : 1;
+    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    const Eigen::Vector3f c = chroma(sv.colours[i]);
+    const float own = (chroma(r.supervoxels[owner].colour) - c).norm();
+    const bool foreign_colour = std::any_of(foreign[owner].begin(), foreign[owner].end(), [&](int f) {
+      return (chroma(r.supervoxels[static_cast<std::size_t>(f)].colour) - c).norm() < own;
+    });
+    voxel_matched[i] = !plane_voxel(r.voxels[i], sv.colours[i]) && !foreign_colour ? 1 : 0;
   }
   return object;
 }

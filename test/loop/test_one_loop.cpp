@@ -76,7 +76,8 @@ double largest_difference(const std::vector<Command>& a, const std::vector<Comma
 TEST(OneLoop, RunReplaysTheCommandsOfASimulatedEpisode) {
   const fs::path dir = fs::path(test::scratch_dir()) / "one_loop";
   const std::string settings = " --set gain=5 --set target_hysteresis=false";
-  const CommandRun sim = run("simulate dvd-one-hand --set duration=1.5 --no-pictures" + settings + " --out " +
+  // select=auto: the object found as `ofv run` finds it in a recording.
+  const CommandRun sim = run("simulate dvd-one-hand --set duration=1.5 --set select=auto --no-pictures" + settings + " --out " +
                              (dir / "episode").string() + " --record " + (dir / "frames").string());
   ASSERT_EQ(sim.code, 0) << sim.err;
   const std::vector<Command> episode = episode_commands(dir / "episode" / "trajectory.csv");
