@@ -1,5 +1,6 @@
 // Perception front end speed: BM_Perception/<width> on a tracking frame
-// (table, DVD case held by a hand, an arm in front), 640x480 and 320x240.
+// (table, DVD case held by a hand, an arm in front), 640x480, 320x240 and
+// 1280x720; BM_PerceptionOfvSupervoxels/<width> with ofv's supervoxel stage.
 // Counters give each stage's mean wall time [ms] and the sizes it worked on.
 // BM_PerceptionScores/<width>: scoring that frame's result against its labels.
 #include "ofv/perception/perception.h"
@@ -11,6 +12,16 @@
 
 namespace {
 
+/// 320x240, 640x480 (4:3, 615 px focal length at 640) or 1280x720 (16:9, the same field across).
+ofv::CameraIntrinsics intrinsics(int width) {
+  ofv::CameraIntrinsics k = ofv::test::vga(width);
+  if (width == 1280) {
+    k.height = 720;
+    k.cy = 360.0;
+  }
+  return k;
+}
+
 ofv::RgbdFrame scene_frame(int width, std::vector<int>* labels = nullptr) {
   using namespace ofv::test;
   SyntheticScene scene = table_and_case();
@@ -19,13 +30,16 @@ ofv::RgbdFrame scene_frame(int width, std::vector<int>* labels = nullptr) {
       make_capsule({0.115, -0.005, 0.03}, {0.115, -0.005, 0.12}, 0.02, skin, kHand));
   scene.shapes.push_back(
       make_capsule({-0.15, -0.2, 0.08}, {0.05, -0.22, 0.16}, 0.025, skin, kHand));
-  return scene.render(vga(width), front_camera(), labels);
+  return scene.render(intrinsics(width), front_camera(), labels);
 }
 
-void BM_Perception(benchmark::State& state) {
+/// The front end on the frame with the supervoxel stage `method`.
+void perception_on_frame(benchmark::State& state, ofv::perception::SupervoxelSettings::Method method) {
   const int width = static_cast<int>(state.range(0));
   const ofv::RgbdFrame frame = scene_frame(width);
-  ofv::perception::Perception perception{ofv::perception::PerceptionSettings{}};
+  ofv::perception::PerceptionSettings settings;
+  settings.supervoxels.method = method;
+  ofv::perception::Perception perception{settings};
   (void)perception.process(frame);  // frame 0: selection
   ofv::perception::PerceptionTimings sum;
   ofv::perception::PerceptionCounts counts;
@@ -54,7 +68,17 @@ void BM_Perception(benchmark::State& state) {
   state.counters["object"] = static_cast<double>(counts.object);
   state.counters["occluders"] = static_cast<double>(counts.occluders);
 }
-BENCHMARK(BM_Perception)->Arg(640)->Arg(320)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Perception(benchmark::State& state) {
+  perception_on_frame(state, ofv::perception::SupervoxelSettings::Method::Pcl);
+}
+BENCHMARK(BM_Perception)->Arg(640)->Arg(320)->Arg(1280)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same with ofv's supervoxel stage (supervoxels=ofv).
+void BM_PerceptionOfvSupervoxels(benchmark::State& state) {
+  perception_on_frame(state, ofv::perception::SupervoxelSettings::Method::Ofv);
+}
+BENCHMARK(BM_PerceptionOfvSupervoxels)->Arg(640)->Arg(320)->Arg(1280)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PerceptionScores(benchmark::State& state) {
   std::vector<int> labels;

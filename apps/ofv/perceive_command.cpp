@@ -79,8 +79,8 @@ Command add_perceive_command(CLI::App& app) {
   sub->add_option("--out", opt->out, "Write frame_NNNNNN.json (and .png) into this directory");
   sub->add_flag("--pictures", opt->pictures, "Also draw a PNG per frame (needs --out)");
   sub->add_option("--set", opt->sets,
-                  "Estimator setting name=value (repeatable); r_seed and r_sphere also set the "
-                  "supervoxel seed resolution and the sphere of the front end")
+                  "Estimator or front-end setting name=value (repeatable; `ofv settings`); r_seed and r_sphere "
+                  "also set the supervoxel seed resolution and the sphere of the front end")
       ->type_name("NAME=VALUE");
   add_selection_options(*sub, opt->box, opt->rect);
   sub->add_option("--max-frames", opt->max_frames, "Stop after this many frames");
@@ -105,9 +105,22 @@ Command add_perceive_command(CLI::App& app) {
               if (opt->pictures && opt->out.empty()) {
                 throw std::invalid_argument("--pictures needs --out DIR");
               }
-              apply_sets(params, opt->sets);
+              // The front end's own rows (supervoxels, beyond_view, ...) go to
+              // it; the others are the estimator's.
+              std::vector<std::string> estimator_sets;
+              std::vector<std::pair<std::string, std::string>> front_end_sets;
+              for (const std::string& assignment : opt->sets) {
+                const auto eq = assignment.find('=');
+                if (eq != std::string::npos && perception::perception_settings_table().find(assignment.substr(0, eq))) {
+                  front_end_sets.emplace_back(assignment.substr(0, eq), assignment.substr(eq + 1));
+                } else {
+                  estimator_sets.push_back(assignment);
+                }
+              }
+              apply_sets(params, estimator_sets);
               settings = params.resolve();
               ps = perception_settings(*opt, settings);
+              perception::perception_settings_table().apply(ps, front_end_sets);
               source = open_source(opt->source, opt->speed);
               if (!opt->out.empty()) {
                 std::error_code ec;

@@ -13,6 +13,7 @@
 #include "ofv/perception/perception.h"
 
 #include "pcl_stages.h"
+#include "vccs.h"
 #include "point_grid.h"
 
 #include <Eigen/Core>

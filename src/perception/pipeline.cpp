@@ -48,7 +48,11 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
 
   // 2. Supervoxels, and the R_adj graph between them.
   stage = std::chrono::steady_clock::now();
-  detail::cluster_supervoxels(cloud, settings.supervoxels, frame.wMc.translation(), sv);
+  if (settings.supervoxels.method == SupervoxelSettings::Method::Pcl) {
+    detail::cluster_supervoxels(cloud, settings.supervoxels, frame.wMc.translation(), sv);
+  } else {
+    detail::vccs_supervoxels(cloud, settings.supervoxels, frame.wMc.translation(), sv);
+  }
   const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
   if (labelled) split_by_labels(frame);
   r.supervoxels = sv.supervoxels;
