@@ -108,6 +108,20 @@ TEST(PerceiveCli, ARecordingWithLabelsIsScored) {
   EXPECT_GE(j["scores"]["object_recall"].get<double>(), 0.95);
   EXPECT_TRUE(j["scores"]["centroid_error_m"].is_null());  // the recording has no object centroid
   EXPECT_TRUE(j["scores"]["occluder_recall"].is_null());
+
+  // The front end's own settings go through --set too: ofv's supervoxel
+  // stage scores as well on the same frames; a word it does not know is exit 2.
+  const fs::path out_ofv = fs::path(test::scratch_dir()) / "ofv_perceive_labelled_ofv";
+  const CommandRun mine = run("perceive " + dir.string() + " --set supervoxels=ofv --out " + out_ofv.string());
+  ASSERT_EQ(mine.code, 0) << mine.err;
+  std::ifstream in_ofv(out_ofv / "frame_000002.json");
+  const auto k = nlohmann::json::parse(in_ofv);
+  EXPECT_GE(k["scores"]["object_precision"].get<double>(), 0.98);
+  EXPECT_GE(k["scores"]["object_recall"].get<double>(), 0.95);
+  EXPECT_NE(k["counts"]["supervoxels"], j["counts"]["supervoxels"]);  // another stage ran
+  const CommandRun bad = run("perceive " + dir.string() + " --set supervoxels=slic");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("supervoxels"), std::string::npos) << bad.err;
 }
 
 TEST(PerceiveCli, AClosedOutputEndsTheRunCleanly) {
