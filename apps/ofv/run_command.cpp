@@ -202,7 +202,7 @@ Command add_run_command(CLI::App& app) {
                 "as SIGTERM does. Needs an X display (exit 2 without one)");
 #endif
   sub->footer("Ctrl-C (or SIGTERM) stops the robot (zero velocity) and exits (0). The object is picked in the first frame "
-              "(--box, --rect, or else the cluster nearest the image centre; a sim: rehearsal takes the scenario's "
+              "(--box, --rect, or else the cluster at the image centre; a sim: rehearsal takes the scenario's "
               "object, select=labels); when it is lost, or a frame is stale (older than stale_timeout "
               "after the previous one, or not after it), the robot stops. An error mid-run (the source, perception or "
               "the robot fails) stops the robot, then is reported (exit 2 for an invalid recording, 1 otherwise). A dry "
@@ -259,7 +259,7 @@ Command add_run_command(CLI::App& app) {
                 if (!opt->box.empty() || !opt->rect.empty()) {
                   throw std::invalid_argument(
                       "--box and --rect are for recordings and sensors; a sim: rehearsal tracks the scenario's object "
-                      "(or, with --set select=auto, the cluster nearest the image centre)");
+                      "(or, with --set select=auto, the cluster at the image centre)");
                 }
                 setup = resolve_episode(sim::load_scenario(opt->source.substr(4)), settings);
                 if (setup.loop.method == ViewMethod::Hindsight) throw std::invalid_argument(servo::kHindsightIsSimulationOnly);

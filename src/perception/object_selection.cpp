@@ -1,5 +1,5 @@
 // The first frame: the support plane, then the object picked by a box, an
-// image selection, or (by default) as the cluster nearest the image centre.
+// image selection, or (by default) as the cluster at the image centre.
 #include "front_end.h"
 
 #include <algorithm>

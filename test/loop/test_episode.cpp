@@ -86,7 +86,7 @@ TEST(Episode, FullPerceptionTracksTheScenariosObjectWhateverIsAtTheImageCentre) 
   // A hand covers the case's centre in the first frame. From the labels
   // (select=labels, the default) perception tracks the case, and the camera
   // stays on the sphere around it; left to itself (select=auto) it picks
-  // the hand, the cluster nearest the image centre, and the camera follows
+  // the hand, the cluster at the image centre, and the camera follows
   // a sphere around the hand.
   const std::string scenario = std::string(OFV_TEST_DATA_DIR) + "/loop/hand-over-case-at-start.yaml";
   const auto run_full = [&](const std::string& select) {

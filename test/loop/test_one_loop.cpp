@@ -107,7 +107,7 @@ TEST(OneLoop, RunReplaysTheCommandsOfASimulatedEpisode) {
 TEST(OneLoop, RunTracksTheObjectThatABoxPointsOut) {
   // A recording whose first frame has a hand in front of the case's centre
   // (it leaves from 0.8 s): by default the front end picks the hand, the
-  // cluster nearest the image centre, and loses it when it leaves; a world
+  // cluster at the image centre, and loses it when it leaves; a world
   // box around the case makes the case the object, never lost.
   const fs::path dir = fs::path(test::scratch_dir()) / "run_box";
   const std::string scenario = std::string(OFV_SOURCE_DIR) + "/test/data/loop/hand-over-case-at-start.yaml";

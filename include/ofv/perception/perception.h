@@ -123,7 +123,7 @@ struct ObjectSelection {
   enum class Mode {
     /// After removing the dominant plane (RANSAC), the cluster of adjacent,
     /// colour-consistent supervoxels (chromaticities within
-    /// TrackingSettings::max_chroma_distance) nearest the image centre.
+    /// TrackingSettings::max_chroma_distance) at the image centre (the surface its centre pixel sees).
     Auto,
     Box,    ///< supervoxels whose centroid is inside `box` (world frame)
     Image,  ///< supervoxels whose centroid projects inside `rect` or onto a non-zero `mask` pixel

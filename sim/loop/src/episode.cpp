@@ -44,7 +44,7 @@ SettingsTable<EpisodeSetup> make_table() {
         [](const E& e) { return std::string(to_string(e.perception)); });
   t.add({"select", "labels | auto", to_string(d.select), "",
          "perception=full, simulation: how the first frame's object is found: the scenario's object from the "
-         "labels (as a user points it out), or the front end's cluster nearest the image centre (ofv run's default)"},
+         "labels (as a user points it out), or the front end's cluster at the image centre (ofv run's default)"},
         [](E& e, const std::string& v) {
           e.select = parse_word<ObjectSelect>("select", v, {{"labels", ObjectSelect::Labels}, {"auto", ObjectSelect::Auto}});
         },

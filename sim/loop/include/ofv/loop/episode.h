@@ -45,7 +45,7 @@ enum class PerceptionMode {
 /// \brief How full perception finds the object in the first frame.
 enum class ObjectSelect {
   Labels,  ///< the scenario's object, as the first frame's labels show it (a user pointing it out)
-  Auto,    ///< the front end's own choice: the colour-consistent cluster nearest the image centre
+  Auto,    ///< the front end's own choice: the colour-consistent cluster at the image centre
 };
 /// \brief The word in settings and files: labels, auto.
 [[nodiscard]] const char* to_string(ObjectSelect select);
