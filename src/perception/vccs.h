@@ -6,15 +6,15 @@
 //     (points sharing a cell are averaged: position and colour), with the
 //     26-neighbourhood of every voxel as index lists.
 //  2. Voxel normals. The smallest principal axis of the voxels within two
-//     rings of neighbours (the voxel's 26-neighbours and theirs, each voxel
-//     once), turned to face the camera; fewer than three voxels, or no
-//     single smallest axis, give no normal (a zero vector: the normal term
-//     of the distance is then at its largest, 1).
+//     rings of neighbours (the voxel, its 26-neighbours and theirs, a voxel
+//     counted once per path to it, as VCCS counts them), turned to face the
+//     camera; voxels on a line or a point give no normal (a zero vector:
+//     the normal term of the distance is then at its largest, 1).
 //  3. Seeds. One per occupied cell of edge R_seed (`seed_resolution`): the
-//     cell's voxel nearest the cell's centre, kept when more than
-//     0.05 pi (R_seed/2)^2 / voxel^2 voxels lie within R_seed/2 of it (a
-//     twentieth of a flat disc of voxels: isolated specks seed nothing).
-//  4. Growth. ceil-free depth D = int(1.8 R_seed / voxel) as in VCCS; D - 1
+//     cell's voxel nearest the cell's centre (the first on a tie), kept when
+//     more than 0.05 pi (R_seed/2)^2 / voxel^2 voxels lie within R_seed/2 of
+//     it (a twentieth of a flat disc of voxels: isolated specks seed nothing).
+//  4. Growth. With D = int(1.8 R_seed / voxel) as in VCCS, D - 1
 //     rounds in which every supervoxel, in seed order, offers each
 //     26-neighbour of its voxels that it does not own the distance
 //        d = w_n (1 - |n_s . n_v|) + w_c |c_s - c_v| / 255 + w_s |x_s - x_v| / R_seed
@@ -35,9 +35,8 @@
 // round measures from a zero centre: the world origin, black, no normal);
 // its seed voxel is its own from the start (PCL leaves the seed voxel free
 // to be taken); normals face the camera (PCL turns them towards the world
-// origin, which is meaningless for a world-frame cloud). Each voxel counts
-// once in its normal's neighbourhood (PCL counts a voxel once per path to
-// it). docs/perception.md measures the two stages against each other.
+// origin, which is meaningless for a world-frame cloud). docs/perception.md
+// measures the two stages against each other.
 #pragma once
 
 #include "pcl_stages.h"
@@ -46,7 +45,7 @@ namespace ofv::perception::detail {
 
 /// The supervoxels of `cloud` (world frame) by the algorithm above; normals
 /// face `camera` (world frame). Deterministic: the same cloud gives the same
-/// output, whatever the order of its points.
+/// output.
 void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& settings, const Eigen::Vector3d& camera,
                       SupervoxelOutput& out);
 
