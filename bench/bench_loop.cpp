@@ -1,5 +1,5 @@
-// The whole simulated closed-loop step (render 320x240 + perception + estimate
-// + control + robot step) on the default scenario: steps per second over
+// The whole simulated closed-loop step (render 320x240 or 640x480 + perception
+// + estimate + control + robot step) on the default scenario: steps per second over
 // one-second episodes (>= 30 keeps up with the sensor); and the throughput of
 // `ofv compare` in episodes per minute.
 #include "ofv/loop/compare.h"
@@ -13,13 +13,16 @@
 
 namespace {
 
-// Arg 0: ground-truth perception, 1: full perception.
+// Args: perception (0 ground truth, 1 full with PCL's supervoxels, 2 full
+// with ofv's), the sensor's width (320: the scenario's fast-320; 640: d435-640).
 void BM_ClosedLoopStep(benchmark::State& state) {
-  const ofv::sim::Scenario s = ofv::sim::load_scenario(ofv::sim::kDefaultScenario);
+  ofv::sim::Scenario s = ofv::sim::load_scenario(ofv::sim::kDefaultScenario);
+  if (state.range(1) == 640) s.sensor.intrinsics = ofv::sim::intrinsics_preset("d435-640");
   const std::string perception = state.range(0) ? "full" : "ground-truth";
+  const std::string supervoxels = state.range(0) == 2 ? "ofv" : "pcl";
   ofv::EpisodeSetup setup;
   try {
-    setup = ofv::resolve_episode(s, {{"perception", perception}, {"duration", "1.0"}});
+    setup = ofv::resolve_episode(s, {{"perception", perception}, {"supervoxels", supervoxels}, {"duration", "1.0"}});
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
     return;
@@ -31,10 +34,15 @@ void BM_ClosedLoopStep(benchmark::State& state) {
   }
   state.SetItemsProcessed(steps);  // items_per_second: closed-loop steps per second
 }
-BENCHMARK(BM_ClosedLoopStep)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ClosedLoopStep)
+    ->ArgsProduct({{0, 1, 2}, {320, 640}})
+    ->ArgNames({"perception", "width"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // ofv compare's harness on 4 built-in scenarios x 2 seeds of 2-second
-// episodes, the paper's settings. Args: jobs, perception (0 ground truth, 1 full).
+// episodes, the paper's settings. Args: jobs, perception (0 ground truth, 1
+// full with PCL's supervoxels, 2 full with ofv's).
 void BM_CompareThroughput(benchmark::State& state) {
   const int jobs = static_cast<int>(state.range(0));
   std::vector<std::pair<std::string, std::string>> scenarios;
@@ -44,7 +52,10 @@ void BM_CompareThroughput(benchmark::State& state) {
   }
   ofv::Grid grid;
   grid.seeds = 2;
-  grid.variants = {{"paper", {{"perception", state.range(1) ? "full" : "ground-truth"}, {"duration", "2.0"}}}};
+  grid.variants = {{"paper",
+                    {{"perception", state.range(1) ? "full" : "ground-truth"},
+                     {"supervoxels", state.range(1) == 2 ? "ofv" : "pcl"},
+                     {"duration", "2.0"}}}};
   const auto episodes = ofv::plan_episodes(scenarios, grid);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("ofv_bench_compare_" + std::to_string(::getpid()));
@@ -62,7 +73,7 @@ void BM_CompareThroughput(benchmark::State& state) {
   state.counters["episodes_per_min"] = 60.0 * static_cast<double>(done) / seconds;
 }
 BENCHMARK(BM_CompareThroughput)
-    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgsProduct({{1, 2}, {0, 1, 2}})
     ->ArgNames({"jobs", "full"})
     ->Unit(benchmark::kSecond)
     ->UseRealTime()
