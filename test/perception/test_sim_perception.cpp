@@ -34,10 +34,12 @@ struct EpisodeStats {
 };
 
 /// Runs the front end on every frame of a scenario from its start camera, up to `until` [s].
-EpisodeStats run_scenario(const std::string& name, double until) {
+EpisodeStats run_scenario(const std::string& name, double until,
+                          perception::SupervoxelSettings::Method supervoxels = perception::SupervoxelSettings{}.method) {
   const sim::Scenario scenario = sim::load_scenario(name);
   sim::Renderer renderer(scenario);
   perception::PerceptionSettings settings;
+  settings.supervoxels.method = supervoxels;
   perception::Perception perception(settings);
   EpisodeStats s;
   const int frames = static_cast<int>(std::min(until, scenario.duration) * scenario.rate);
@@ -143,6 +145,26 @@ TEST(SimPerception, ClothOccluder) {
 // measured, 7.6 mm of it the half thickness the camera never sees; 18.5 mm
 // when the hidden part was left behind), and the visible part's own C is
 // checked on the frames with nothing hidden.
+// ofv's supervoxel stage against PCL's on the same frames (docs/perception.md
+// "Two supervoxel stages"): the front end is as right with either, worst
+// frame by worst frame, on a hand over the case and on the bending cloth.
+TEST(SimPerception, OfvSupervoxelsScoreAsPcls) {
+  using Method = perception::SupervoxelSettings::Method;
+  for (const auto& [name, until] : {std::pair<const char*, double>{"dvd-one-hand", 2.5}, {"cloth-occluder", 4.0}}) {
+    SCOPED_TRACE(name);
+    const EpisodeStats pcl = run_scenario(name, until, Method::Pcl);
+    const EpisodeStats mine = run_scenario(name, until, Method::Ofv);
+    EXPECT_EQ(mine.lost, 0);
+    EXPECT_EQ(mine.scored, pcl.scored);
+    EXPECT_GE(mine.worst_precision, std::min(pcl.worst_precision, 0.99) - 0.01);
+    EXPECT_GE(mine.worst_recall, pcl.worst_recall - 0.01);
+    EXPECT_LE(mine.worst_visible_centroid_error, std::max(pcl.worst_visible_centroid_error, 0.005) + 0.002);
+    EXPECT_EQ(mine.frames_occluder_found, mine.frames_with_occluder_in_sphere);
+    EXPECT_EQ(mine.frames_holder_interacting, mine.frames_holder_visible);
+    EXPECT_EQ(mine.holder_as_object, 0);
+  }
+}
+
 TEST(SimPerception, MovingObject) {
   const EpisodeStats s = run_scenario("moving-object", 5.0);
   expect_quality(s, /*whole_object_centroid=*/false);
