@@ -174,10 +174,12 @@ void grow_into_boundary(const std::vector<SupervoxelInfo>& supervoxels,
 }
 
 /// The world point seen at the pixel with depth nearest the image centre
-/// (rings of growing radius, within the image); none without depth.
+/// (the principal point: what the camera points at; rings of growing
+/// radius, within the image); none without depth.
 std::optional<Eigen::Vector3f> centre_point(const RgbdFrame& frame) {
   const CameraIntrinsics& k = frame.intrinsics;
-  const int cu = k.width / 2, cv = k.height / 2;
+  const int cu = std::clamp(static_cast<int>(std::lround(k.cx)), 0, k.width - 1);
+  const int cv = std::clamp(static_cast<int>(std::lround(k.cy)), 0, k.height - 1);
   const int rings = std::max(k.width, k.height);
   for (int ring = 0; ring <= rings; ++ring) {
     std::optional<std::pair<int, int>> found;

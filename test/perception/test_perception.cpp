@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <type_traits>
 #include <cmath>
+#include <limits>
 
 namespace ofv {
 namespace {
@@ -68,6 +69,28 @@ TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
       ASSERT_TRUE(r.obb.contains(r.voxels[i].cast<double>()));
     }
   }
+}
+
+TEST(Perception, DefaultSelectionTakesWhatTheImageCentreShows) {
+  // A forearm across the image just off its centre: the case, which the
+  // centre pixel sees, is the object, not the arm (nearer the camera).
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(arm_in_front());
+  perception::Perception perception{perception::PerceptionSettings{}};
+  const Frame f = render(scene, test::front_camera());
+  ASSERT_EQ(f.labels[f.frame.index(320, 240)], kObject);
+  const perception::PerceptionResult r = perception.process(f.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
+  const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+  EXPECT_EQ(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Object), 0);
+  EXPECT_GT(test::count_truth_as(r, truth, kObject, perception::SupervoxelClass::Object), 10);
+  // A frame without any depth selects nothing, and says so.
+  RgbdFrame blank = f.frame;
+  std::fill(blank.depth.begin(), blank.depth.end(), std::numeric_limits<float>::quiet_NaN());
+  perception::Perception fresh{perception::PerceptionSettings{}};
+  const perception::PerceptionResult none = fresh.process(blank);
+  EXPECT_EQ(none.status, perception::TrackingStatus::Lost);
+  EXPECT_FALSE(none.message.empty());
 }
 
 TEST(Perception, SupportPlaneCanBeLeftOutOfTheOccluders) {
