@@ -12,13 +12,14 @@
 
 namespace ofv::perception::detail {
 
-/// Supervoxels of one frame and the voxels they own.
+/// Supervoxels of one frame and the voxels they own (from either stage:
+/// cluster_supervoxels() below or vccs_supervoxels() in vccs.h).
 struct SupervoxelOutput {
   std::vector<SupervoxelInfo> supervoxels;    // label Background, normal oriented to the camera
   std::vector<Eigen::Vector3f> voxels;        // world frame [m]
   std::vector<Eigen::Vector3f> colours;       // R, G, B per voxel
   std::vector<int> owner;                     // index into supervoxels, per voxel
-  std::vector<std::pair<int, int>> touching;  // pairs (i < j) whose voxels touch (PCL adjacency)
+  std::vector<std::pair<int, int>> touching;  // pairs (i < j) whose voxels touch (26-neighbours)
 
   void clear() {
     supervoxels.clear();
