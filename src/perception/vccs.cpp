@@ -129,6 +129,28 @@ struct Voxels {
     }
   }
 
+  /// True when more than `count` voxels (voxel i among them) lie within
+  /// `radius` of voxel i; stops counting as soon as there are.
+  [[nodiscard]] bool more_within(int i, float radius, float voxel, double count) const {
+    const Feature& f = features[static_cast<std::size_t>(i)];
+    const Eigen::Vector3i& c = cells[static_cast<std::size_t>(i)];
+    const int reach = static_cast<int>(std::ceil(radius / voxel));
+    int found = 1;
+    if (found > count) return true;
+    for (int dz = -reach; dz <= reach; ++dz) {
+      for (int dy = -reach; dy <= reach; ++dy) {
+        for (int dx = -reach; dx <= reach; ++dx) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const int j = map.find(cell_key(c + Eigen::Vector3i(dx, dy, dz)));
+          if (j >= 0 && (features[static_cast<std::size_t>(j)].position - f.position).norm() <= radius && ++found > count) {
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
   /// Step 2: each voxel's normal from its two rings of neighbours, counted
   /// as VCCS does: the voxel, each neighbour, and each neighbour's
   /// neighbours (a voxel once per path to it). Moments [1, x, y, z, xx, xy,
@@ -212,23 +234,12 @@ void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& setting
   }
   const float search = 0.5f * seed;
   const double min_count = 0.05 * M_PI * static_cast<double>(search) * search / (static_cast<double>(voxel) * voxel);
-  const int reach = static_cast<int>(std::ceil(search / voxel));
   std::vector<Growing> growing;
   std::vector<int> owner(n, -1);
   std::vector<float> best(n, std::numeric_limits<float>::infinity());
   for (const int s : candidates) {
+    if (!v.more_within(s, search, voxel, min_count)) continue;
     const Feature& f = v.features[static_cast<std::size_t>(s)];
-    int count = 1;  // voxels within R_seed / 2 (the seed, then others until there are enough)
-    for (int dz = -reach; dz <= reach && !(count > min_count); ++dz) {
-      for (int dy = -reach; dy <= reach && !(count > min_count); ++dy) {
-        for (int dx = -reach; dx <= reach && !(count > min_count); ++dx) {
-          if (dx == 0 && dy == 0 && dz == 0) continue;
-          const int j = v.map.find(cell_key(v.cells[static_cast<std::size_t>(s)] + Eigen::Vector3i(dx, dy, dz)));
-          if (j >= 0 && (v.features[static_cast<std::size_t>(j)].position - f.position).norm() <= search) ++count;
-        }
-      }
-    }
-    if (!(count > min_count)) continue;
     owner[static_cast<std::size_t>(s)] = static_cast<int>(growing.size());
     best[static_cast<std::size_t>(s)] = 0.0f;
     growing.push_back({f, {s}});
