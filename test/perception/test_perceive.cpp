@@ -79,27 +79,24 @@ TEST(Perceive, AFrameThatFailsItsChecksIsSkippedAndCountedManyInARowEndTheRun) {
   EXPECT_EQ(summary.frames, static_cast<long>(frames.size()) - 1);
   EXPECT_EQ(summary.bad_frames, 1);
   EXPECT_NE(summary.last_bad_frame.find("depth"), std::string::npos) << summary.last_bad_frame;
-  std::vector<RgbdFrame> broken(11, short_read);
-  VectorSource all_bad(broken);
-  try {
-    (void)perceive_all(all_bad, -1);
-    ADD_FAILURE() << "11 bad frames in a row went on";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("11 bad frames in a row"), std::string::npos) << e.what();
-  }
+  // The run ends with an error naming the bound it went past.
+  const auto expect_ended = [](std::vector<RgbdFrame> run, const std::string& bound) {
+    VectorSource bad_run(std::move(run));
+    try {
+      (void)perceive_all(bad_run, -1);
+      ADD_FAILURE() << bound << " went on";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(bound), std::string::npos) << e.what();
+    }
+  };
+  expect_ended(std::vector<RgbdFrame>(11, short_read), "11 bad frames in a row");
   // Never two in a row, but 31 within a minute.
   std::vector<RgbdFrame> every_other;
   for (int k = 0; k < 31; ++k) {
     every_other.push_back(frames[0]);
     every_other.push_back(short_read);
   }
-  VectorSource often_bad(every_other);
-  try {
-    (void)perceive_all(often_bad, -1);
-    ADD_FAILURE() << "31 bad frames in a minute went on";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("31 bad frames in a minute"), std::string::npos) << e.what();
-  }
+  expect_ended(every_other, "31 bad frames in a minute");
 }
 
 TEST(Perceive, EstimatesEachFrameWarmStartedFromTheLastView) {
