@@ -16,7 +16,9 @@ command line.
 
 Arrays are float64 numpy arrays (any strides) or lists of numbers; other
 dtypes raise TypeError, other shapes ValueError. Bad input raises ValueError
-with the command line's message, any other failure RuntimeError. The GIL is
+with the command line's message (numbers out of range however large, text
+with a NUL or a lone surrogate), an argument of another type TypeError, any
+other failure RuntimeError. The GIL is
 released while the estimator, episodes, renders and sweeps run.
 """
 

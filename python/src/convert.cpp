@@ -25,6 +25,15 @@ std::string array_shape(const py::array& a) {
 
 bool is_real(const py::handle& h) { return PyFloat_Check(h.ptr()) || (PyLong_Check(h.ptr()) && !PyBool_Check(h.ptr())); }
 
+// A float, or a real number that is not an int or a bool (numpy's float32, say).
+bool is_number(const py::handle& h) {
+  if (PyFloat_Check(h.ptr())) return true;
+  if (PyBool_Check(h.ptr()) || py::isinstance<py::array>(h)) return false;
+  return PyLong_Check(h.ptr()) || py::isinstance(h, py::module_::import("numbers").attr("Real"));
+}
+
+std::string type_name(const py::handle& h) { return py::str(py::type::of(h).attr("__name__")).cast<std::string>(); }
+
 bool is_sequence(const py::handle& h) { return py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h); }
 
 [[noreturn]] void wrong_type(const py::handle& obj, const std::string& name, const std::string& expected) {
@@ -123,15 +132,105 @@ py::array_t<double> matrix_to_numpy(const Eigen::MatrixXd& m) {
   return out;
 }
 
+std::string text_arg(const py::handle& obj, const std::string& name) {
+  if (!PyUnicode_Check(obj.ptr())) throw py::type_error(name + ": expected a str, got a " + type_name(obj));
+  Py_ssize_t size = 0;
+  const char* utf8 = PyUnicode_AsUTF8AndSize(obj.ptr(), &size);
+  if (utf8 == nullptr) {
+    PyErr_Clear();
+    throw py::value_error(name + ": not valid text (a lone surrogate character cannot be written as UTF-8)");
+  }
+  std::string text(utf8, static_cast<std::size_t>(size));
+  if (text.find('\0') != std::string::npos) throw py::value_error(name + ": contains a NUL character");
+  return text;
+}
+
+std::string path_arg(const py::handle& obj, const std::string& name) {
+  if (PyUnicode_Check(obj.ptr())) return text_arg(obj, name);
+  if (py::hasattr(obj, "__fspath__")) {
+    const py::object path = py::module_::import("os").attr("fspath")(obj);
+    if (PyUnicode_Check(path.ptr())) return text_arg(path, name);
+  }
+  throw py::type_error(name + ": expected a path (str or os.PathLike of str), got a " + type_name(obj));
+}
+
+long long integer_arg(const py::handle& obj, const std::string& name, long long lo, long long hi) {
+  const std::string range = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (PyBool_Check(obj.ptr()) || !PyIndex_Check(obj.ptr()) || py::isinstance<py::array>(obj)) {
+    throw py::type_error(name + ": expected " + range + ", got a " + type_name(obj));
+  }
+  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(obj.ptr()));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long value = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0 || value < lo || value > hi) {
+    throw py::value_error(name + ": expected " + range + ", got " + py::repr(index).cast<std::string>());
+  }
+  return value;
+}
+
+double number_arg(const py::handle& obj, const std::string& name, double lo, double hi) {
+  const std::string range = "a number in [" + format_number(lo) + ", " + format_number(hi) + "]";
+  if (!is_number(obj)) throw py::type_error(name + ": expected " + range + ", got a " + type_name(obj));
+  const double value = PyFloat_AsDouble(obj.ptr());
+  if (value == -1.0 && PyErr_Occurred()) {  // an int too large for a double
+    PyErr_Clear();
+    throw py::value_error(name + ": expected " + range + ", got " + py::repr(obj).cast<std::string>());
+  }
+  if (!(value >= lo && value <= hi)) throw py::value_error(name + ": expected " + range + ", got " + format_number(value));
+  return value;
+}
+
+namespace {
+
+thread_local bool t_in_call = false;  // a Cls(...) call is under way: its __new__ may run
+
+PyTypeObject* pybind11_metaclass() { return py::detail::get_internals().default_metaclass; }
+
+}  // namespace
+
+py::metaclass constructed_only(py::module_& m) {
+  if (!py::hasattr(m, "_Type")) {
+    const py::handle base(reinterpret_cast<PyObject*>(pybind11_metaclass()));
+    py::dict body;
+    body["__module__"] = m.attr("__name__");
+    body["__doc__"] = "The metaclass of ofv's classes: X.__new__ runs only inside X(...).";
+    const py::object meta = py::handle(reinterpret_cast<PyObject*>(&PyType_Type))("_Type", py::make_tuple(base), body);
+    meta.attr("__call__") = py::cpp_function(
+        [](const py::handle& cls, const py::args& args, const py::kwargs& kwargs) {
+          t_in_call = true;
+          PyObject* made = pybind11_metaclass()->tp_call(cls.ptr(), args.ptr(), kwargs.ptr());
+          t_in_call = false;
+          if (made == nullptr) throw py::error_already_set();
+          return py::reinterpret_steal<py::object>(made);
+        },
+        py::is_method(meta));
+    m.attr("_Type") = meta;
+  }
+  return py::metaclass(m.attr("_Type"));
+}
+
+void refuse_bare_new(const py::handle& cls) {
+  cls.attr("__new__") = py::staticmethod(py::cpp_function([](const py::handle& type, const py::args&, const py::kwargs&) {
+    if (!t_in_call) {
+      const std::string name = py::str(type.attr("__name__")).cast<std::string>();
+      throw py::type_error(name + ".__new__(" + name + ") alone would make a " + name + " without its value: make one with " +
+                           name + "(...) or get one from the function that returns it");
+    }
+    t_in_call = false;  // this call's object only: not one its __init__ would make
+    return py::reinterpret_steal<py::object>(py::detail::pybind11_object_new(
+        reinterpret_cast<PyTypeObject*>(type.ptr()), nullptr, nullptr));
+  }));
+}
+
 std::string setting_text(const std::string& name, const py::handle& value) {
   if (PyBool_Check(value.ptr())) return format_bool(value.cast<bool>());
-  if (PyFloat_Check(value.ptr())) return format_number(value.cast<double>());
   if (PyLong_Check(value.ptr()) || (PyIndex_Check(value.ptr()) && !py::isinstance<py::array>(value))) {
     return py::str(py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()))).cast<std::string>();
   }
-  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
-  throw py::type_error("setting '" + name + "': expected a bool, int, float or str, got a " +
-                       py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  if (is_number(value)) return format_number(PyFloat_AsDouble(value.ptr()));
+  if (PyUnicode_Check(value.ptr())) return text_arg(value, "setting '" + name + "'");
+  throw py::type_error("setting '" + name + "': expected a bool, int, float or str, got a " + type_name(value));
 }
 
 py::object typed_value(const SettingDoc& doc, const std::string& text) {
@@ -145,7 +244,7 @@ py::object typed_value(const SettingDoc& doc, const std::string& text) {
 std::vector<std::pair<std::string, std::string>> settings_pairs(const py::dict& settings) {
   std::vector<std::pair<std::string, std::string>> out;
   for (const auto& [key, value] : settings) {
-    const auto name = py::str(key).cast<std::string>();
+    const auto name = text_arg(key, "setting name");
     out.emplace_back(name, setting_text(name, value));
   }
   return out;

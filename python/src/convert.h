@@ -41,6 +41,36 @@ py::array_t<double> vector_to_numpy(const Eigen::VectorXd& v);
 py::array_t<double> matrix_to_numpy(const Eigen::MatrixXd& m);
 
 /**
+ * \brief A Python str as UTF-8 text.
+ * \throws py::type_error naming `name` for anything but a str; py::value_error
+ *         for a str that is no text a file or a setting can hold (a lone
+ *         surrogate, which UTF-8 cannot write, or a NUL character).
+ */
+std::string text_arg(const py::handle& obj, const std::string& name);
+
+/// \brief A path: a str or an os.PathLike giving one, checked as text_arg() does.
+std::string path_arg(const py::handle& obj, const std::string& name);
+
+/// \brief A Python int (or numpy integer; not a bool) in [lo, hi].
+/// \throws py::type_error for another type, py::value_error naming the range otherwise.
+long long integer_arg(const py::handle& obj, const std::string& name, long long lo, long long hi);
+
+/// \brief A real number (int, float or numpy floating; not a bool), finite and in [lo, hi].
+/// \throws py::type_error for another type, py::value_error naming the range otherwise.
+double number_arg(const py::handle& obj, const std::string& name, double lo, double hi);
+
+/**
+ * \brief The module's metaclass: `Cls(...)` as pybind11's, and `Cls.__new__`
+ *        usable only inside such a call. Alone, `__new__` would give an
+ *        object without its C++ value (its methods would read uninitialised
+ *        memory). Made once per module (kept as its attribute `_Type`).
+ */
+py::metaclass constructed_only(py::module_& m);
+
+/// \brief Gives `cls` (made with constructed_only()'s metaclass) the `__new__` that refuses to run alone.
+void refuse_bare_new(const py::handle& cls);
+
+/**
  * \brief A setting's value as the text its table's setter parses: bool as
  *        `true`/`false`, int as digits, float as the shortest text that
  *        reads back the same, str as it is.

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <pybind11/stl.h>
 
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -46,7 +47,7 @@ void set_setting(EstimatorParams& p, const std::string& name, const py::handle& 
 }
 
 void apply_settings(EstimatorParams& p, const py::dict& settings) {
-  for (const auto& [key, value] : settings) set_setting(p, py::str(key).cast<std::string>(), value);
+  for (const auto& [key, value] : settings) set_setting(p, text_arg(key, "setting name"), value);
 }
 
 // `settings=`: None (the defaults), an EstimatorSettings (copied) or a dict of settings by name.
@@ -142,22 +143,34 @@ std::string settings_class_doc() {
 
 }  // namespace
 
+// An enum pickles as its class called with its value (not through __new__, which refuse_bare_new() guards).
+template <class Enum>
+void finish_enum(py::enum_<Enum>& e) {
+  e.def("__reduce__", [](const py::object& self) { return py::make_tuple(py::type::of(self), py::make_tuple(py::int_(self))); });
+  refuse_bare_new(e);
+}
+
 void bind_estimator(py::module_& m) {
+  const py::metaclass meta = constructed_only(m);
 
   py::enum_<ViewStatus> status(m, "ViewStatus",
                                "Outcome of one estimate (spec §4, §8); a member's name is its word in "
-                               "`ofv estimate`'s JSON ('converged', ...).");
+                               "`ofv estimate`'s JSON ('converged', ...).", meta);
   for (auto v : {ViewStatus::Converged, ViewStatus::NotConverged, ViewStatus::OutOfTime, ViewStatus::NoOccluders,
                  ViewStatus::NoSupervoxels}) {
     status.value(to_string(v), v);
   }
+  finish_enum(status);
   py::enum_<InitialViewUsed> used(m, "InitialViewUsed",
-                                  "Which rule produced t0 after the spec's fallbacks (spec §2); the name is its word.");
+                                  "Which rule produced t0 after the spec's fallbacks (spec §2); the name is its word.", meta);
   for (auto v : {InitialViewUsed::SphericalMean, InitialViewUsed::VectorMean, InitialViewUsed::Camera}) {
     used.value(to_string(v), v);
   }
+  finish_enum(used);
 
-  py::class_<AngularErrorStats>(m, "AngularErrorStats", "Mean and population standard deviation of an angular error (eq. 9) [deg].")
+  py::class_<AngularErrorStats> stats(m, "AngularErrorStats", "Mean and population standard deviation of an angular error (eq. 9) [deg].", meta);
+  refuse_bare_new(stats);
+  stats
       .def_readonly("mean", &AngularErrorStats::mean, "mean [deg]")
       .def_readonly("std", &AngularErrorStats::std, "population standard deviation [deg]")
       .def("__repr__", [](const AngularErrorStats& a) {
@@ -165,7 +178,8 @@ void bind_estimator(py::module_& m) {
       });
 
   // --- EstimatorSettings
-  py::class_<EstimatorParams> settings(m, "EstimatorSettings", settings_class_doc().c_str());
+  py::class_<EstimatorParams> settings(m, "EstimatorSettings", settings_class_doc().c_str(), meta);
+  refuse_bare_new(settings);
   settings.def(py::init([](const py::kwargs& kw) {
                  EstimatorParams p;
                  apply_settings(p, kw);
@@ -202,18 +216,19 @@ void bind_estimator(py::module_& m) {
       })
       .def_static("docs", [] { return docs_to_python(estimator_settings_table().docs()); },
                   "Every setting: a list of dicts with name, type, default, unit and doc (as `ofv settings`).")
-      .def(py::pickle([](const EstimatorParams& p) { return settings_dict(p); },
-                      [](const py::dict& d) {
-                        EstimatorParams p;
-                        apply_settings(p, d);
-                        return p;
-                      }));
+      // Pickled as EstimatorSettings() and then every setting as an
+      // attribute, in the table's order (pickle's "slot state").
+      .def("__reduce__", [](const py::object& self) {
+        return py::make_tuple(py::type::of(self), py::tuple(), py::make_tuple(py::none(), settings_dict(self.cast<EstimatorParams>())));
+      });
   settings.attr("__hash__") = py::none();
 
   // --- ViewEstimate
-  py::class_<ViewEstimate>(m, "ViewEstimate",
+  py::class_<ViewEstimate> estimate(m, "ViewEstimate",
                            "The estimator's result for one frame (spec §8), world frame, metres. Points are float64\n"
-                           "arrays of shape (3,); axes and path have one point per row.")
+                           "arrays of shape (3,); axes and path have one point per row.", meta);
+  refuse_bare_new(estimate);
+  estimate
       .def_property_readonly("t0", [](const ViewEstimate& e) { return vector_to_numpy(e.t0); }, "initial (occlusion-blind) view t0 [m]")
       .def_property_readonly("tf", [](const ViewEstimate& e) { return vector_to_numpy(e.tf); }, "final (occlusion-free) view t_f [m]")
       .def_readonly("status", &ViewEstimate::status, "ViewStatus: converged, not_converged, out_of_time, no_occluders, no_supervoxels")
@@ -279,10 +294,12 @@ with the message of `ofv estimate`, on invalid settings or input. The GIL is
 released while the estimator runs.)");
 
   // --- Scene
-  py::class_<PyScene>(m, "Scene",
+  py::class_<PyScene> scene(m, "Scene",
                       "One frame as `ofv estimate` reads it (ESTIMATOR-SPEC.md §8): supervoxels, occluders, the\n"
                       "optional centroid, axes, camera and previous view, and the settings (\"params\").\n"
-                      "Scene.load(path) / save(path) read and write the scene JSON of `ofv estimate`.")
+                      "Scene.load(path) / save(path) read and write the scene JSON of `ofv estimate`.", meta);
+  refuse_bare_new(scene);
+  scene
       .def(py::init([](const py::object& positions, const py::object& normals, const py::object& occluders,
                        const py::object& centroid, const py::object& axes, const py::object& camera,
                        const py::object& previous_view, const py::object& base, const py::kwargs& kw) {
@@ -297,7 +314,8 @@ released while the estimator runs.)");
            py::arg("previous_view") = py::none(), py::arg("settings") = py::none(),
            "Scene(positions, normals, occluders=None, *, centroid=None, axes=None, camera=None, previous_view=None,\n"
            "settings=None, **settings): arguments as estimate_view().")
-      .def_static("load", [](const std::string& path) {
+      .def_static("load", [](const py::object& path_obj) {
+            const std::string path = path_arg(path_obj, "path");
             PyScene s;
             {
               py::gil_scoped_release release;
@@ -311,7 +329,9 @@ released while the estimator runs.)");
             }
             return s;
           }, py::arg("path"), "Reads a scene file (the JSON of `ofv estimate`); ValueError naming the file, field and value.")
-      .def_static("from_json", [](const std::string& text, const std::string& source) {
+      .def_static("from_json", [](const py::object& text_obj, const py::object& source_obj) {
+            const std::string text = text_arg(text_obj, "text");
+            const std::string source = text_arg(source_obj, "source");
             PyScene s;
             s.scene = scene_from_text(text, source);
             s.source = source;
@@ -320,7 +340,8 @@ released while the estimator runs.)");
           }, py::arg("text"), py::arg("source") = "<string>", "Parses a scene from JSON text; `source` names it in errors.")
       .def("to_json", [](const PyScene& s) { return to_pretty_string(scene_json(s.scene)) + "\n"; },
            "The scene file's text (every explicitly given setting in \"params\").")
-      .def("save", [](const PyScene& s, const std::string& path) {
+      .def("save", [](const PyScene& s, const py::object& path_obj) {
+            const std::string path = path_arg(path_obj, "path");
             const std::string text = to_pretty_string(scene_json(s.scene)) + "\n";
             std::ofstream out(path, std::ios::binary);
             out << text;
@@ -373,6 +394,18 @@ released while the estimator runs.)");
 
 }  // namespace ofv::python
 
+namespace {
+
+// A message that quotes a file's bytes may not be UTF-8: raised with those bytes replaced, never as a decoding error.
+void set_error(PyObject* type, const char* message) {
+  PyObject* text = PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)), "replace");
+  if (text == nullptr) return;  // out of memory: that error stands
+  PyErr_SetObject(type, text);
+  Py_DECREF(text);
+}
+
+}  // namespace
+
 PYBIND11_MODULE(_ofv, m) {
   namespace py = pybind11;
   m.doc() = "ofv's C++ core (the package ofv re-exports it): the occlusion-free view estimator, "
@@ -389,9 +422,9 @@ PYBIND11_MODULE(_ofv, m) {
     } catch (const std::bad_alloc&) {
       throw;
     } catch (const std::invalid_argument& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+      set_error(PyExc_ValueError, e.what());
     } catch (const std::exception& e) {
-      PyErr_SetString(PyExc_RuntimeError, e.what());
+      set_error(PyExc_RuntimeError, e.what());
     }
   });
   m.attr("__version__") = ofv::version();

@@ -40,29 +40,9 @@ namespace {
 
 sim::Scenario scenario_arg(const py::handle& obj) {
   if (py::isinstance<sim::Scenario>(obj)) return obj.cast<sim::Scenario>();
-  if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) {
-    const auto path = py::str(py::module_::import("os").attr("fspath")(obj)).cast<std::string>();
-    return sim::load_scenario(path);
-  }
+  if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) return sim::load_scenario(path_arg(obj, "scenario"));
   throw py::type_error("scenario: expected a Scenario, a built-in scenario's name or a scenario file, got a " +
                        py::str(py::type::of(obj).attr("__name__")).cast<std::string>());
-}
-
-std::string path_arg(const py::handle& obj, const std::string& name) {
-  if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) {
-    return py::str(py::module_::import("os").attr("fspath")(obj)).cast<std::string>();
-  }
-  throw py::type_error(name + ": expected a path (str or os.PathLike), got a " +
-                       py::str(py::type::of(obj).attr("__name__")).cast<std::string>());
-}
-
-// A Python int or numpy integer, not a bool.
-bool is_integer(const py::handle& h) {
-  return PyIndex_Check(h.ptr()) && !PyBool_Check(h.ptr()) && !py::isinstance<py::array>(h);
-}
-
-long long integer(const py::handle& h) {
-  return py::reinterpret_steal<py::object>(PyNumber_Index(h.ptr())).cast<long long>();
 }
 
 py::array_t<double> pose_matrix(const Eigen::Isometry3d& wMc) { return matrix_to_numpy(Eigen::MatrixXd(wMc.matrix())); }
@@ -274,25 +254,19 @@ Eigen::Isometry3d pose_arg(const py::handle& pose) {
   return wMc;
 }
 
-Frame render(const py::object& scenario_obj, double time, const py::object& pose, const py::object& size, bool noise,
-             const py::object& out) {
+Frame render(const py::object& scenario_obj, const py::object& time_obj, const py::object& pose, const py::object& size,
+             bool noise, const py::object& out) {
   const sim::Scenario scenario = scenario_arg(scenario_obj);
-  if (!(time >= 0.0) || time > 3600.0) {
-    throw py::value_error("time: expected a time in [0, 3600] s, got " + format_number(time));
-  }
+  const double time = number_arg(time_obj, "time", 0.0, 3600.0);
   CameraIntrinsics k = scenario.sensor.intrinsics;
   if (!size.is_none()) {
     if (!py::isinstance<py::tuple>(size) && !py::isinstance<py::list>(size)) {
       throw py::type_error("size: expected (width, height)");
     }
     const auto wh = py::reinterpret_borrow<py::sequence>(size);
-    const bool ints = py::len(wh) == 2 && is_integer(wh[0]) && is_integer(wh[1]);
-    const long long w = ints ? integer(wh[0]) : 0;
-    const long long h = ints ? integer(wh[1]) : 0;
-    if (w < 8 || h < 8 || w > 4096 || h > 4096) {
-      throw py::value_error("size: expected (width, height), integers in [8, 4096], got " +
-                            py::repr(size).cast<std::string>());
-    }
+    if (py::len(wh) != 2) throw py::value_error("size: expected (width, height), got " + py::repr(size).cast<std::string>());
+    const long long w = integer_arg(wh[0], "size: the width", 8, 4096);
+    const long long h = integer_arg(wh[1], "size: the height", 8, 4096);
     k.fx *= static_cast<double>(w) / k.width;
     k.fy *= static_cast<double>(h) / k.height;
     k.cx *= static_cast<double>(w) / k.width;
@@ -338,7 +312,7 @@ Frame render(const py::object& scenario_obj, double time, const py::object& pose
 
 // --- compare: `ofv compare` without the printing
 
-py::dict compare(const py::object& scenarios, const py::object& grid_obj, const std::string& out,
+py::dict compare(const py::object& scenarios, const py::object& grid_obj, const py::object& out_obj,
                  const py::object& seeds, const py::object& jobs, const py::object& shard_text, bool plots) {
   std::vector<std::string> args;
   if (py::isinstance<py::str>(scenarios) || py::hasattr(scenarios, "__fspath__")) {
@@ -347,13 +321,10 @@ py::dict compare(const py::object& scenarios, const py::object& grid_obj, const 
     for (const auto& s : scenarios) args.push_back(path_arg(s, "scenarios"));
   }
   if (args.empty()) throw py::value_error("scenarios: expected at least one scenario");
+  const std::string out = path_arg(out_obj, "out");
   auto int_arg = [](const py::object& v, const std::string& name, int hi) -> std::optional<int> {
     if (v.is_none()) return std::nullopt;
-    if (!is_integer(v) || integer(v) < 1 || integer(v) > hi) {
-      throw py::value_error(name + ": expected an integer in 1.." + std::to_string(hi) + ", got " +
-                            py::repr(v).cast<std::string>());
-    }
-    return static_cast<int>(integer(v));
+    return static_cast<int>(integer_arg(v, name, 1, hi));
   };
   const auto n_seeds = int_arg(seeds, "seeds", kMaxSeeds);
   const auto n_jobs = int_arg(jobs, "jobs", kMaxJobs);
@@ -362,7 +333,7 @@ py::dict compare(const py::object& scenarios, const py::object& grid_obj, const 
   if (py::isinstance<py::dict>(grid_obj)) {
     // JSON is YAML: the grid of docs/compare.md as Python dicts and lists.
     source = "grid";
-    grid = grid_from_yaml(py::module_::import("json").attr("dumps")(grid_obj).cast<std::string>(), source);
+    grid = grid_from_yaml(text_arg(py::module_::import("json").attr("dumps")(grid_obj), source), source);
   } else {
     source = path_arg(grid_obj, "grid");
     grid = read_grid(source);
@@ -377,7 +348,7 @@ py::dict compare(const py::object& scenarios, const py::object& grid_obj, const 
   check_grid(set, grid, source);
   const auto plan = plan_episodes(set, grid);
   Shard part;
-  if (!shard_text.is_none()) part = parse_shard(shard_text.cast<std::string>());
+  if (!shard_text.is_none()) part = parse_shard(text_arg(shard_text, "shard"));
   SweepOptions options;
   options.jobs = n_jobs.value_or(0);
   options.part = part;
@@ -405,15 +376,18 @@ py::dict compare(const py::object& scenarios, const py::object& grid_obj, const 
 }  // namespace
 
 void bind_simulation(py::module_& m) {
+  const py::metaclass meta = constructed_only(m);
   m.attr("LABEL_NONE") = static_cast<int>(sim::kLabelNone);
   m.attr("LABEL_OBJECT") = static_cast<int>(sim::kLabelObject);
   m.attr("LABEL_INTERACTING") = static_cast<int>(sim::kLabelInteracting);
   m.attr("LABEL_BACKGROUND") = static_cast<int>(sim::kLabelBackground);
   m.attr("LABEL_OCCLUDER0") = static_cast<int>(sim::kLabelOccluder0);
 
-  py::class_<sim::Scenario>(m, "Scenario",
+  py::class_<sim::Scenario> scenario(m, "Scenario",
                             "A simulated world (docs/scenarios.md): object, occluders and their motion, sensor, camera\n"
-                            "start, and the scenario's own settings. load_scenario() reads one.")
+                            "start, and the scenario's own settings. load_scenario() reads one.", meta);
+  refuse_bare_new(scenario);
+  scenario
       .def_readonly("name", &sim::Scenario::name, "file stem, e.g. 'dvd-one-hand'")
       .def_readonly("path", &sim::Scenario::path, "the file it came from")
       .def_readonly("duration", &sim::Scenario::duration, "episode length [s]")
@@ -436,9 +410,13 @@ void bind_simulation(py::module_& m) {
             for (const auto& b : s.bodies) names.push_back(b.name);
             return names;
           }, "names of the bodies, the object first")
-      .def("with_seed", [](const sim::Scenario& s, unsigned k) { return sim::with_seed(s, k); }, py::arg("k"),
+      .def("with_seed", [](const sim::Scenario& s, const py::object& k) {
+            return sim::with_seed(s, static_cast<unsigned>(integer_arg(k, "k", 0, 1000000000)));  // the range of the setting seed
+          }, py::arg("k"),
            "The scenario's k-th random world (0: as written), as `--seed k`.")
-      .def_static("from_yaml", &sim::scenario_from_yaml, py::arg("text"), py::arg("source") = "<string>",
+      .def_static("from_yaml", [](const py::object& text, const py::object& source) {
+            return sim::scenario_from_yaml(text_arg(text, "text"), text_arg(source, "source"));
+          }, py::arg("text"), py::arg("source") = "<string>",
                   "Parses a scenario from YAML text; `source` names it in errors.")
       .def("__repr__", [](const sim::Scenario& s) {
         return "Scenario('" + s.name + "', " + format_number(s.duration) + " s at " + format_number(s.rate) + " Hz, " +
@@ -454,7 +432,9 @@ void bind_simulation(py::module_& m) {
         "Every setting of an episode (simulate()'s keywords, `ofv simulate --set`): a list of dicts with name,\n"
         "type, default, unit and doc.");
 
-  py::class_<Episode>(m, "Episode", "A closed-loop episode's results, as `ofv simulate` writes them.")
+  py::class_<Episode> episode(m, "Episode", "A closed-loop episode's results, as `ofv simulate` writes them.", meta);
+  refuse_bare_new(episode);
+  episode
       .def_readonly("settings", &Episode::settings,
                     "every setting the episode ran with, resolved (the scenario's, then the keywords), by the\n"
                     "names of episode_settings(): simulate(scenario, **episode.settings) runs it again")
@@ -491,7 +471,9 @@ released while it runs: Python threads can run episodes in parallel.
         py::arg("pictures") = false, py::arg("video") = false, py::arg("record") = py::none(),
         py::arg("callback") = py::none(), simulate_doc.c_str());
 
-  py::class_<Frame>(m, "Frame", "One rendered RGB-D frame (ViSP's camera frame: X right, Y down, Z forward).")
+  py::class_<Frame> frame(m, "Frame", "One rendered RGB-D frame (ViSP's camera frame: X right, Y down, Z forward).", meta);
+  refuse_bare_new(frame);
+  frame
       .def_readonly("depth", &Frame::depth, "(H, W) float32 Z depth [m]; 0 or NaN where missing")
       .def_readonly("colour", &Frame::colour, "(H, W, 3) uint8 RGB")
       .def_readonly("labels", &Frame::labels,

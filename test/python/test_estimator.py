@@ -183,6 +183,64 @@ def test_settings_copy_pickle_and_equality():
     assert s.copy() == s and s != ofv.EstimatorSettings()
 
 
+# --- what the binding library would otherwise see
+
+
+def _classes():
+    """Every class of the extension (a class added later is checked too)."""
+    return [c for c in vars(ofv._ofv).values()
+            if isinstance(c, type) and not issubclass(c, BaseException) and c is not ofv._ofv._Type]
+
+
+@pytest.mark.parametrize("cls", _classes(), ids=lambda c: c.__name__)
+def test_objects_made_without_their_constructor_are_refused(cls):
+    # Without the check, their methods read memory no constructor wrote.
+    with pytest.raises(TypeError, match=rf"^{cls.__name__}\.__new__\({cls.__name__}\) alone would make"):
+        cls.__new__(cls)
+
+
+def test_subclasses_enums_and_pickles_still_construct():
+    class Settings(ofv.EstimatorSettings):
+        pass
+
+    assert Settings(r_sphere=0.3).r_sphere == 0.3
+    s = ofv.EstimatorSettings(preset="authors_code", r_sphere=0.4, max_iterations=7)
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        assert pickle.loads(pickle.dumps(s, protocol=protocol)) == s
+        for member in (ofv.ViewStatus.out_of_time, ofv.InitialViewUsed.camera):
+            assert pickle.loads(pickle.dumps(member, protocol=protocol)) == member
+    assert ofv.ViewStatus(2) == ofv.ViewStatus.out_of_time and copy.deepcopy(s) == s
+
+
+@pytest.mark.parametrize("call,error,message", [
+    (lambda: ofv.EstimatorSettings(preset="paper\udc80"), ValueError, r"^setting 'preset': not valid text \(a lone surrogate"),
+    (lambda: ofv.EstimatorSettings(preset="paper\0"), ValueError, "^setting 'preset': contains a NUL character$"),
+    (lambda: ofv.EstimatorSettings(**{"r_sphere\udc80": 0.3}), ValueError, "^setting name: not valid text"),
+    (lambda: ofv.EstimatorSettings(max_iterations=10**30), ValueError, r"must be an integer in \[0, 100000000\]"),
+    (lambda: ofv.EstimatorSettings(r_sphere=10**400), ValueError, "'r_sphere' must be a finite number"),
+    (lambda: ofv.Scene.load("scene\0.json"), ValueError, "^path: contains a NUL character$"),
+    (lambda: ofv.Scene.load("\udc80.json"), ValueError, "^path: not valid text"),
+    (lambda: ofv.Scene.load(b"scene.json"), TypeError, r"^path: expected a path \(str or os.PathLike of str\), got a bytes$"),
+    (lambda: ofv.Scene.from_json("{}", source="\udc80"), ValueError, "^source: not valid text"),
+    (lambda: ofv.Scene.from_json(1), TypeError, "^text: expected a str, got a int$"),
+])
+def test_numbers_that_do_not_fit_and_text_no_file_can_hold_raise_the_documented_errors(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+def test_a_path_with_a_nul_writes_nothing(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    positions, normals, _ = _scene_arrays()
+    with pytest.raises(ValueError, match="^path: contains a NUL character$"):
+        ofv.Scene(positions, normals).save("scene\0.json")
+    assert list(tmp_path.iterdir()) == []  # not a file "scene" beside it
+
+
+def test_numpy_scalars_are_numbers():
+    assert ofv.EstimatorSettings(r_sphere=np.float32(0.25), max_iterations=np.int64(9)).to_dict()["r_sphere"] == 0.25
+
+
 # --- scenes
 
 

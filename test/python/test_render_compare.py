@@ -58,16 +58,22 @@ def test_render_pose_as_matrix_or_theta_u_and_size(tmp_path, run_cli):
 
 
 @pytest.mark.parametrize("kwargs,error,message", [
-    ({"time": -1.0}, ValueError, r"time: expected a time in \[0, 3600\] s, got -1"),
-    ({"time": math.nan}, ValueError, "time: expected a time"),
+    ({"time": -1.0}, ValueError, r"time: expected a number in \[0, 3600\], got -1"),
+    ({"time": math.nan}, ValueError, "time: expected a number"),
+    ({"time": 10**400}, ValueError, r"time: expected a number in \[0, 3600\], got 1000"),
+    ({"time": "0"}, TypeError, r"time: expected a number in \[0, 3600\], got a str"),
     ({"pose": [0, 0, math.nan, 0, 0, 0]}, ValueError, r"pose: value 3 is nan, expected a finite number in \[-1000, 1000\]"),
     ({"pose": [0, 0, 2000.0, 0, 0, 0]}, ValueError, "pose: value 3 is 2000"),
     ({"pose": [0, 0, 1]}, ValueError, r"pose: expected a float64 array of shape \(6,\)"),
     ({"pose": np.diag([1.0, 2.0, 1.0, 1.0])}, ValueError, "pose: expected a homogeneous transform"),
     ({"pose": np.eye(4, dtype=np.int64)}, TypeError, "pose: expected a float64 array"),
-    ({"size": (4, 4)}, ValueError, r"size: expected \(width, height\), integers in \[8, 4096\]"),
-    ({"size": (64.0, 48)}, ValueError, "size: expected"),
-    ({"size": (True, 48)}, ValueError, "size: expected"),
+    ({"size": (4, 4)}, ValueError, r"size: the width: expected an integer in \[8, 4096\], got 4"),
+    ({"size": (64, 10**30)}, ValueError, r"size: the height: expected an integer in \[8, 4096\], got 1000"),
+    ({"size": (64, 48, 1)}, ValueError, r"size: expected \(width, height\)"),
+    ({"size": (64.0, 48)}, TypeError, "size: the width: expected an integer in .* got a float"),
+    ({"size": (True, 48)}, TypeError, "size: the width: expected an integer in .* got a bool"),
+    ({"out": "pictures\0"}, ValueError, "out: contains a NUL character"),
+    ({"out": b"pictures"}, TypeError, r"out: expected a path \(str or os.PathLike of str\), got a bytes"),
 ])
 def test_bad_render_arguments_are_refused(kwargs, error, message):
     args = {"time": 0.0, **kwargs}
@@ -138,10 +144,14 @@ def test_bad_compare_arguments_raise_the_command_lines_message(tmp_path, run_cli
     assert "ofv compare: " + str(raised.value) == err.strip()
     with pytest.raises(ValueError, match="gain"):
         ofv.compare("dvd-static", bad)
-    with pytest.raises(ValueError, match=r"seeds: expected an integer in 1..1000, got 0"):
+    with pytest.raises(ValueError, match=r"seeds: expected an integer in \[1, 1000\], got 0"):
         ofv.compare("dvd-static", GRID, seeds=0)
-    with pytest.raises(ValueError, match=r"jobs: expected an integer in 1..256, got 1.5"):
+    with pytest.raises(ValueError, match=r"jobs: expected an integer in \[1, 256\], got 1000000000000000000000"):
+        ofv.compare("dvd-static", GRID, jobs=10**21)
+    with pytest.raises(TypeError, match=r"jobs: expected an integer in \[1, 256\], got a float"):
         ofv.compare("dvd-static", GRID, jobs=1.5)
+    with pytest.raises(ValueError, match="out: contains a NUL character"):
+        ofv.compare("dvd-static", GRID, out=tmp_path / "o\0")
     with pytest.raises(ValueError, match="no-such-scenario"):
         ofv.compare("no-such-scenario", GRID)
     with pytest.raises(FileNotFoundError, match="episodes.csv"):
