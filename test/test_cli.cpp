@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -194,3 +195,32 @@ TEST_F(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
 }
 
 }  // namespace
+
+// The exit status of `sh -c COMMAND` run with standard output into a pipe
+// whose reader is already gone (`ofv ... | head` once head has left); -1 when killed by a signal.
+int exit_code_into_a_closed_pipe(const std::string& command) {
+  int fds[2];
+  if (pipe(fds) != 0) return -2;
+  close(fds[0]);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(fds[1], STDOUT_FILENO);
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(fds[1]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST_F(Cli, AClosedOutputIsNoKillAndAFullOneIsAnError) {
+  const std::string ofv_bin = std::string("\"") + OFV_BINARY + "\" ";
+  for (const std::string& args : std::vector<std::string>{"settings", "settings --markdown", "estimate \"" + kExample + "\"", "--help-all"}) {
+    EXPECT_EQ(exit_code_into_a_closed_pipe(ofv_bin + args + " 2>/dev/null"), 0) << args;
+  }
+  const fs::path err = dir_ / "stderr";
+  const int status = std::system((ofv_bin + "settings >/dev/full 2>\"" + err.string() + "\"").c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status;
+  EXPECT_EQ(slurp(err), "ofv: the output could not be written\n");
+}

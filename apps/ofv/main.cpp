@@ -3,12 +3,41 @@
 
 #include "ofv/version.h"
 
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <iostream>
 #include <string>
 #include <vector>
 
+namespace {
+
+// Whether standard output is a pipe whose reader has gone (`ofv ... | head`).
+bool output_reader_gone() {
+  struct stat st {};
+  if (fstat(STDOUT_FILENO, &st) != 0 || !S_ISFIFO(st.st_mode)) return false;
+  pollfd out{STDOUT_FILENO, 0, 0};
+  return poll(&out, 1, 0) == 1 && (out.revents & POLLERR) != 0;
+}
+
+// A command's exit code once its output is flushed: a reader that stopped
+// reading took what it wanted (as with a Unix tool under `| head`, nothing
+// more is said); any other failed write is an error.
+int finish_output(int code) {
+  if (std::cout.flush() || output_reader_gone()) return code;
+  std::cerr << "ofv: the output could not be written\n";
+  return code != ofv::cli::kOk ? code : ofv::cli::kRuntimeFailure;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace ofv::cli;
+  // A closed output is a write error the commands see (`ofv run` stops the
+  // robot on it), never a kill.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{
       "ofv - occlusion-free view: keep a target object in clear view of an eye-in-hand RGB-D\n"
       "camera (Cuiral-Zueco & Lopez-Nicolas, \"Dynamic Occlusion Handling for Real Time\n"
@@ -58,7 +87,7 @@ int main(int argc, char** argv) {
   }
   for (const Command& command : commands) {
     if (command.app->parsed()) {
-      return command.run();
+      return finish_output(command.run());
     }
   }
   return kUsage;

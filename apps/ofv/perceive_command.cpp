@@ -11,7 +11,6 @@
 #include "ofv/sources/open_source.h"
 #include "ofv/sources/openni2_source.h"
 
-#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
@@ -140,9 +139,8 @@ Command add_perceive_command(CLI::App& app) {
             }
 
             // `ofv perceive ... | head`: a line that cannot be written (EPIPE,
-            // SIGPIPE ignored) ends the run cleanly, saying why.
+            // SIGPIPE ignored in main) ends the run cleanly, saying why.
             struct ReaderGone {};
-            std::signal(SIGPIPE, SIG_IGN);
             try {
               const perception::PerceiveSummary summary = perception::perceive(
                   *source, ps, settings, opt->max_frames, [&](const perception::PerceivedFrame& f) {

@@ -214,9 +214,6 @@ Command add_run_command(CLI::App& app) {
             // driver) must end the run with a stop too, not kill it.
             std::signal(SIGINT, on_signal);
             std::signal(SIGTERM, on_signal);
-            // A closed output (`ofv run --dry-run | head`) is seen as a write
-            // error, which stops the run with the robot at rest, not a kill.
-            std::signal(SIGPIPE, SIG_IGN);
             const bool simulated = opt->source.rfind("sim:", 0) == 0;
             const bool real = opt->robot.size() > 5 && opt->robot.compare(opt->robot.size() - 5, 5, "-real") == 0;
             EpisodeSetup setup;
