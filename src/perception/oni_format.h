@@ -7,6 +7,7 @@
 //                           u64 undo position; then fields, then payload
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace ofv::oni {
@@ -34,6 +35,11 @@ constexpr std::uint32_t fourcc(char a, char b, char c, char d) {
          (static_cast<std::uint32_t>(static_cast<std::uint8_t>(d)) << 24);
 }
 constexpr std::uint32_t kCodecUncompressed = fourcc('N', 'O', 'N', 'E');
+// The compressed ones (OpenNI2's XnCodecIDs.h; byte formats in oni_codecs.h).
+constexpr std::uint32_t kCodec16z = fourcc('1', '6', 'z', 'P');
+constexpr std::uint32_t kCodec16zTables = fourcc('1', '6', 'z', 'T');
+constexpr std::uint32_t kCodec8z = fourcc('I', 'm', '8', 'z');
+constexpr std::uint32_t kCodecJpeg = fourcc('J', 'P', 'E', 'G');
 constexpr std::size_t kFileHeaderBytes = 24;
 constexpr std::size_t kRecordHeaderBytes = 28;
 constexpr std::size_t kMaxNameBytes = 80;  // XN_MAX_NAME_LENGTH, the terminating NUL included
