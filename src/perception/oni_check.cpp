@@ -1,8 +1,10 @@
 // check_oni_file(): the structure of a .oni file, walked record by record
 // before OpenNI2's player sees it (the player trusts sizes, node ids and
-// offsets, and crashes on a single changed byte).
+// offsets, and crashes on a single changed byte), and every compressed frame
+// decoded (oni_codecs.h): OpenNI2's decoders trust their payloads too.
 #include "ofv/sources/openni2_source.h"
 
+#include "oni_codecs.h"
 #include "oni_format.h"
 
 #include <OniCEnums.h>
@@ -149,6 +151,7 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
   if (max_node > 16) fail(20, "max node id " + std::to_string(max_node) + ", more than 16");
   std::vector<NodeState> nodes(max_node + 1);
   std::set<std::uint64_t> records;
+  std::vector<std::uint8_t> decoded;  // a compressed frame, decoded: one at a time
 
   std::uint64_t at = kFileHeaderBytes;
   for (bool end = false; !end;) {
@@ -187,8 +190,8 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
         }
         const std::uint64_t codec_at = f.here();
         n.codec = f.get<std::uint32_t>("codec");
-        if (n.codec != kCodecUncompressed && n.codec != fourcc('1', '6', 'z', 'T') && n.codec != fourcc('1', '6', 'z', 'P') &&
-            n.codec != fourcc('I', 'm', '8', 'z') && n.codec != fourcc('J', 'P', 'E', 'G')) {
+        if (n.codec != kCodecUncompressed && n.codec != kCodec16zTables && n.codec != kCodec16z && n.codec != kCodec8z &&
+            n.codec != kCodecJpeg) {
           fail(codec_at, "codec " + std::to_string(n.codec));
         }
         n.frames_at = f.here();
@@ -300,6 +303,17 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
           fail(at + 16, "payload size " + std::to_string(payload) + ", the node's mode and pixel format need " + std::to_string(expected));
         }
         if (payload == 0) fail(at + 16, "empty frame");
+        if (n.codec != kCodecUncompressed) {
+          if (n.required != expected) {
+            fail(at, "frame of node " + std::to_string(id) + ": oniRequiredFrameSize " + std::to_string(n.required) +
+                         ", the node's mode and pixel format need " + std::to_string(expected));
+          }
+          // OpenNI2's decoders trust the payload: it must decode, bounded, to exactly that frame.
+          const FrameShape shape{n.crop_width != 0 ? n.crop_width : n.width, n.crop_width != 0 ? n.crop_height : n.height,
+                                 n.bytes_per_pixel};
+          const std::string why = decode_frame(n.codec, read(at + fields_size, payload).data(), payload, shape, decoded);
+          if (!why.empty()) fail(at + fields_size, why);
+        }
         n.last_data = at;
         n.last_time = time;
         n.data.insert(at);

@@ -50,8 +50,9 @@ struct OpenNi2Options {
  * per pixel of the node's mode), undo positions at earlier records, frame
  * numbers 1, 2, ... per node and as many as NODE_ADDED claims, a seek table
  * (OpenNI2's recorder writes one) pointing at frames of its node; the video
- * mode at most 4096 x 4096, the field of view in (0, pi). Compressed payloads
- * (16zT, JPEG) are left to OpenNI2's decoders.
+ * mode at most 4096 x 4096, the field of view in (0, pi). Every compressed
+ * frame (codecs 16zP, 16zT, Im8z, JPEG) is decoded, one at a time and bounded,
+ * and must give exactly that frame (JPEG: its width, height and channels).
  * \throws std::invalid_argument "PATH: offset N: what" at the first problem.
  */
 void check_oni_file(const std::string& path);
