@@ -23,8 +23,10 @@
 //                nibble then is a difference, 0xD (nothing) or 0xF (the byte
 //                after is the next pixel itself)
 //     0xE0-0xEF  a run: 2 x (byte - 0xE0) copies of the previous pixel
-//   JPEG: one JFIF/JPEG stream (libjpeg), 1 component for GRAY8 frames, 3 for
-//     RGB888 ones (OpenNI2's codec factory refuses JPEG for other formats).
+//   JPEG: one JPEG stream, SOI to EOI, decoded by libjpeg to RGB: 1 component
+//     for GRAY8 frames, 3 for RGB888 ones (OpenNI2's codec factory refuses
+//     JPEG for other formats). OpenNI2 reads it from memory and cannot give
+//     libjpeg more: a stream cut short before EOI is refused here.
 // All arithmetic on pixels (16zP, 16zT indices) or bytes (Im8z) wraps as
 // OpenNI2's decoders' does.
 #pragma once
