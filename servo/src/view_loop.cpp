@@ -61,7 +61,7 @@ struct ViewLoop::Impl {
   struct SeenView {
     Eigen::Vector3d position;
     double shown = 0.0;
-    Eigen::Matrix3Xd occluders;
+    Eigen::Matrix3Xd occluders;  // seen there, but those of tracks moving then
     double age = 0.0;  // time since [s]
     TrackPositions tracks;
   };
@@ -91,7 +91,7 @@ struct ViewLoop::Impl {
   void lost(const Eigen::Vector3d& here, double dt, LoopStep& out);
   bool camera_cost_view(const Frame& f);
   [[nodiscard]] SeenView seen_here(const Frame& f) const {
-    return SeenView{f.here, f.shown, f.problem.occluders.leftCols(f.seen), 0.0, world.positions()};
+    return SeenView{f.here, f.shown, world.without_moving(f.problem.occluders.leftCols(f.seen)), 0.0, world.positions()};
   }
 
   LoopSettings settings;
@@ -285,8 +285,9 @@ void ViewLoop::Impl::transition(Guard guard, LoopStep& out) {
 // Guard camera_cost_view (mode pursue), with the evidence it keeps: the view
 // that showed the most in the last `memory`, and the frames in a row that
 // showed `drop` less away from it. The loss must come from the
-// camera's own motion: with the occluders as they were when that view
-// showed the most, and those of this frame known to stand still (revealed
+// camera's own motion: with the occluders that stood when that view showed
+// the most (those moving then are elsewhere now, wherever the camera is),
+// and those of this frame known to stand still (revealed
 // by the motion: WorldModel::revealed_still), here shows less than there by
 // `drop` too (occluders that moved in since cost the object wherever
 // the camera is); and with this frame's occluders, that view must not show

@@ -2,7 +2,9 @@
 #include "world_model.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <set>
 
 namespace ofv::servo {
 
@@ -70,6 +72,22 @@ Eigen::Matrix3Xd WorldModel::revealed_still(const TrackPositions& then) const {
     if (!history.arrived && (t.position - since).norm() <= moved_) still.push_back(t);
   }
   return still_occluders(still, min_speed_);
+}
+
+Eigen::Matrix3Xd WorldModel::without_moving(const Eigen::Matrix3Xd& seen) const {
+  // A track's points are copies of the frame's: found by their exact coordinates.
+  const auto key = [](const Eigen::Vector3d& p) { return std::array<double, 3>{p.x(), p.y(), p.z()}; };
+  std::set<std::array<double, 3>> moving;
+  for (const OccluderTrack& t : tracker_.tracks()) {
+    if (!is_moving(t, min_speed_)) continue;
+    for (Eigen::Index i = 0; i < t.points.cols(); ++i) moving.insert(key(t.points.col(i)));
+  }
+  if (moving.empty()) return seen;
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index i = 0; i < seen.cols(); ++i) {
+    if (moving.count(key(seen.col(i))) == 0) kept.push_back(i);
+  }
+  return seen(Eigen::all, kept);
 }
 
 }  // namespace ofv::servo

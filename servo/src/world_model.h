@@ -39,6 +39,10 @@ class WorldModel {
   /// then, of where they were first seen): what the camera's own motion may
   /// have revealed since.
   [[nodiscard]] Eigen::Matrix3Xd revealed_still(const TrackPositions& then) const;
+  /// The frame's seen occluders (those update() took) but the points of the
+  /// tracks moving now (is_moving()): where they are says nothing of where
+  /// they will be.
+  [[nodiscard]] Eigen::Matrix3Xd without_moving(const Eigen::Matrix3Xd& seen) const;
 
  private:
   /// What the loop keeps of a track since it was first seen.

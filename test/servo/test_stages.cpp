@@ -118,6 +118,23 @@ TEST(WorldModel, RevealedStillIsWhatStoodStillSinceThenWhereverTheSceneIs) {
   }
 }
 
+TEST(WorldModel, WithoutMovingKeepsWhatStandsAndWhatIsNotTracked) {
+  const Eigen::Vector3d still(0.0, 0.1, 0.4), from(-0.1, 0.0, 0.4), v(0.3, 0.0, 0.0);
+  const WorldModel world = watched(still, from, v, 10);
+  // The last frame's points as update() took them, and one it never saw.
+  Eigen::Matrix3Xd seen(3, 9);
+  seen << cluster(still), cluster(from + v * (9 / 30.0)), Eigen::Vector3d(0.2, 0.2, 0.2);
+  const Eigen::Matrix3Xd kept = world.without_moving(seen);
+  ASSERT_EQ(kept.cols(), 5);
+  EXPECT_TRUE(kept.leftCols(4).isApprox(cluster(still)));
+  EXPECT_TRUE(kept.col(4).isApprox(Eigen::Vector3d(0.2, 0.2, 0.2)));
+  // Nothing moving: all of it.
+  const WorldModel calm = watched(still, from, Eigen::Vector3d::Zero(), 10);
+  Eigen::Matrix3Xd calm_seen(3, 8);
+  calm_seen << cluster(still), cluster(from);
+  EXPECT_EQ(calm.without_moving(calm_seen).cols(), 8);
+}
+
 TEST(WorldModel, APeriodThatIsNotATimeStartsTheTracksAgain) {
   WorldModel world = watched({0, 0.1, 0.4}, {-0.1, 0, 0.4}, {0.3, 0, 0}, 10);
   const Eigen::Matrix3Xd seen = cluster({0, 0.1, 0.4});
