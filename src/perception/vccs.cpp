@@ -67,7 +67,8 @@ struct Voxels {
   std::vector<Eigen::Vector3i> cells;
   std::vector<int> first;       // neighbours of i: neighbours[first[i] .. first[i + 1])
   std::vector<int> neighbours;
-  CellMap map;
+  CellMap map;  // every occupied cell -> its voxel (two cells for a merged one)
+  std::vector<std::pair<Eigen::Vector3i, int>> owners;  // every occupied cell and its voxel
 
   void build(const WorldCloud& cloud, float inv_voxel) {
     // Voxels in the order of their first point; points sharing a cell averaged.
@@ -95,8 +96,10 @@ struct Voxels {
       features[i].position /= static_cast<float>(count[i]);
       features[i].colour /= static_cast<float>(count[i]);
     }
+    merge_split_patches(1.0f / inv_voxel);
     const std::size_t n = features.size();
-    // Half of the 26 offsets find each pair once; the lists get both ends.
+    // Half of the 26 offsets find each pair once, from every cell of a
+    // voxel; the lists get both ends.
     static const std::array<Eigen::Vector3i, 13> kForward = [] {
       std::array<Eigen::Vector3i, 13> out;
       std::size_t k = 0;
@@ -110,15 +113,18 @@ struct Voxels {
       return out;
     }();
     std::vector<std::pair<int, int>> pairs;
-    first.assign(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (const auto& [c, i] : owners) {
       for (const Eigen::Vector3i& d : kForward) {
-        const int j = map.find(cell_key(cells[i] + d));
-        if (j < 0) continue;
-        pairs.emplace_back(static_cast<int>(i), j);
-        ++first[i + 1];
-        ++first[static_cast<std::size_t>(j) + 1];
+        const int j = map.find(cell_key(c + d));
+        if (j >= 0 && j != i) pairs.emplace_back(std::min(i, j), std::max(i, j));
       }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    first.assign(n + 1, 0);
+    for (const auto& [i, j] : pairs) {
+      ++first[static_cast<std::size_t>(i) + 1];
+      ++first[static_cast<std::size_t>(j) + 1];
     }
     for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
     neighbours.resize(2 * pairs.size());
@@ -127,6 +133,64 @@ struct Voxels {
       neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(i)]++)] = j;
       neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = i;
     }
+  }
+
+  /// A surface lying along a cell face (a cloth facing the camera at a
+  /// cell's boundary) leaves its points on both sides of it, as its noise
+  /// decides from frame to frame: two voxels, face neighbours, whose means
+  /// are closer than 0.4 voxel across that face, where the surface elsewhere
+  /// gives one. Each such pair becomes one voxel (the two means and colours
+  /// averaged; both cells lead to it), so that a patch of surface counts
+  /// once in what is taken over voxels (C, the axes, the supervoxels' sizes)
+  /// wherever the grid cuts it. A surface crossing a column of cells at a
+  /// slope s splits it into halves s / 2 apart: the pairs joined are those of
+  /// surfaces within 39 degrees of the face; steeper ones (45 degrees and
+  /// more) keep a voxel per cell. Halves of other colours are two surfaces
+  /// touching, not one. A voxel joins at most one other.
+  void merge_split_patches(float voxel) {
+    // Two surfaces that touch (a finger on a case) differ in colour more than one surface's noise.
+    constexpr float kSameColour = 25.0f;  // RGB distance, of 441 at most
+    const std::size_t n = features.size();
+    std::vector<int> survivor(n);  // the voxel each one becomes
+    for (std::size_t i = 0; i < n; ++i) survivor[i] = static_cast<int>(i);
+    std::vector<char> paired(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int axis = 0; axis < 3 && !paired[i]; ++axis) {
+        const int j = map.find(cell_key(cells[i] + Eigen::Vector3i::Unit(axis)));
+        if (j < 0 || paired[static_cast<std::size_t>(j)]) continue;
+        Feature& a = features[i];
+        const Feature& b = features[static_cast<std::size_t>(j)];
+        if (std::abs(a.position(axis) - b.position(axis)) >= 0.4f * voxel ||
+            (a.colour - b.colour).norm() >= kSameColour) {
+          continue;
+        }
+        a.position = 0.5f * (a.position + b.position);
+        a.colour = 0.5f * (a.colour + b.colour);
+        paired[i] = paired[static_cast<std::size_t>(j)] = 1;
+        survivor[static_cast<std::size_t>(j)] = static_cast<int>(i);
+      }
+    }
+    // Survivors keep their order; every cell leads to its voxel's new index.
+    std::vector<int> index(n, -1);
+    int kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (survivor[i] != static_cast<int>(i)) continue;
+      index[i] = kept;
+      features[static_cast<std::size_t>(kept)] = features[i];
+      ++kept;
+    }
+    owners.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      const int to = index[static_cast<std::size_t>(survivor[i])];
+      map.find_or_insert(cell_key(cells[i])) = to;
+      owners.emplace_back(cells[i], to);
+    }
+    std::vector<Eigen::Vector3i> kept_cells(static_cast<std::size_t>(kept));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (index[i] >= 0) kept_cells[static_cast<std::size_t>(index[i])] = cells[i];
+    }
+    features.resize(static_cast<std::size_t>(kept));
+    cells.swap(kept_cells);
   }
 
   /// True when more than `count` voxels (voxel i among them) lie within
@@ -142,7 +206,8 @@ struct Voxels {
         for (int dx = -reach; dx <= reach; ++dx) {
           if (dx == 0 && dy == 0 && dz == 0) continue;
           const int j = map.find(cell_key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (j >= 0 && (features[static_cast<std::size_t>(j)].position - f.position).norm() <= radius && ++found > count) {
+          if (j >= 0 && j != i && (features[static_cast<std::size_t>(j)].position - f.position).norm() <= radius &&
+              ++found > count) {
             return true;
           }
         }
