@@ -9,6 +9,7 @@ packages=(
   libvisp-dev
   libpcl-dev
   libopencv-dev
+  libopencv-contrib-dev  # ofv::odometry (OpenCV's rgbd module); optional: without it the rest builds
   libopenni2-dev
   libembree-dev libtbb-dev libassimp-dev
   nlohmann-json3-dev libcli11-dev libyaml-cpp-dev

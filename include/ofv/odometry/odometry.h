@@ -1,0 +1,158 @@
+/**
+ * \file odometry.h
+ * \brief Camera poses without a robot: RGB-D odometry on OpenCV's rgbd
+ *        module (opencv_contrib), frame to keyframe or frame to frame.
+ *
+ * Each step matches the new frame (the source) against a reference frame
+ * (the last keyframe, or the previous frame) and gives the motion
+ * `kMc` (camera -> reference camera, OpenCV's `Rt`: p_k = Rt p_c); the
+ * world pose is `wMc = wMk * kMc`, starting at the first frame's own `wMc`.
+ * A frame with too few usable pixels (Failed), or a step OpenCV reports
+ * failed or whose motion is not finite, too large
+ * (OdometrySettings::max_translation, max_rotation) or matched by too few
+ * pixels (Implausible), is a status: the pose stays the last good one.
+ *
+ * \code
+ * ofv::odometry::Odometry odometry;  // ICPOdometry against a keyframe
+ * while (auto frame = source->next()) {
+ *   const ofv::odometry::OdometryResult r = odometry.step(*frame);
+ *   if (r.status == ofv::odometry::OdometryStatus::Ok) frame->wMc = r.wMc;
+ * }
+ * \endcode
+ */
+#pragma once
+
+#include "ofv/rgbd_frame.h"
+#include "ofv/settings_table.h"
+
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace ofv::odometry {
+
+/// \brief Which of OpenCV's rgbd odometries runs.
+enum class OdometryMethod {
+  Icp,      ///< cv::rgbd::ICPOdometry: point-to-plane ICP on depth (`icp`)
+  RgbdIcp,  ///< cv::rgbd::RgbdICPOdometry: ICP and photometric terms (`rgbd_icp`)
+  FastIcp,  ///< cv::rgbd::FastICPOdometry: KinectFusion's projective ICP (`fast_icp`)
+  Rgbd,     ///< cv::rgbd::RgbdOdometry: photometric, needs texture (`rgbd`)
+};
+
+/// \brief What one step of the odometry found.
+enum class OdometryStatus {
+  Ok,           ///< the motion was estimated and is plausible; the pose moved
+  FirstFrame,   ///< the first frame: the pose is the frame's own wMc
+  /// The frame alone gives nothing to match: too few usable pixels
+  /// (OdometrySettings::min_valid_fraction; a blank depth image), or OpenCV
+  /// threw on it. The pose is the last good one.
+  Failed,
+  /// The frame does not fit the reference: OpenCV found no motion (with
+  /// pixels enough), or one that is not finite, larger than max_translation
+  /// or max_rotation, or after which too few pixels match
+  /// (min_inlier_fraction). The pose is the last good one.
+  Implausible,
+};
+
+/**
+ * \brief The odometry's settings, defaults from the measurements in
+ *        docs/perception.md ("Camera poses from RGB-D odometry"). The
+ *        table odometry_settings_table() documents and parses them.
+ */
+struct OdometrySettings {
+  OdometryMethod method = OdometryMethod::Icp;  ///< which OpenCV odometry
+  bool keyframe = true;  ///< match against the last keyframe (false: against the previous frame)
+  double keyframe_translation = 0.03;  ///< a new keyframe when the camera moved more than this from it [m]
+  double keyframe_rotation = 3.0;      ///< ... or turned more than this from it [deg]
+  double max_translation = 0.05;       ///< a step's motion beyond this is implausible [m per frame]
+  double max_rotation = 5.0;           ///< a step's rotation beyond this is implausible [deg per frame]
+  double min_valid_fraction = 0.05;    ///< fewer of the image's pixels with usable depth (after the mask): failed
+  double min_inlier_fraction = 0.6;    ///< fewer of the used pixels matching the reference after the motion: implausible
+  double max_depth_diff = 0.07;  ///< a pixel matches when its depth differs by at most this [m] (OpenCV's maxDepthDiff)
+  double min_depth = 0.1;        ///< pixels nearer than this are not used [m]
+  double max_depth = 4.0;        ///< pixels farther than this are not used [m]
+  int iterations = 7;  ///< ICP iterations at each of the 3 finer pyramid levels, 1.5x at the coarsest (OpenCV's default 7)
+  double max_points_part = 0.07;  ///< share of the pixels OpenCV samples (ICP, RGB-D; OpenCV's maxPointsPart)
+  bool mask = true;  ///< leave out pixels nearer than the object's depth minus mask_margin, when the caller gives it
+  double mask_margin = 0.10;  ///< [m] see `mask`: the hands and occluders in front of the object
+};
+
+/// \brief The numbers behind a step's status.
+struct OdometryDiagnostics {
+  double valid_fraction = 0.0;   ///< of the image's pixels, those used (depth in range, not masked)
+  double masked_fraction = 0.0;  ///< of the image's pixels, those the mask left out
+  double inlier_fraction = 0.0;  ///< of the used pixels, those matching the reference within max_depth_diff
+  double residual = 0.0;         ///< RMS depth difference of the matching pixels [m]
+  double translation = 0.0;      ///< the step's motion from the previous pose [m] (as found, even when rejected)
+  double rotation = 0.0;         ///< the step's rotation from the previous pose [deg]
+  bool converged = false;        ///< OpenCV's compute() found a motion
+  double orthonormality = 0.0;   ///< |R^T R - I| of OpenCV's rotation before it is re-orthonormalised
+  bool keyframe = false;         ///< this frame became the reference
+  double ms = 0.0;               ///< wall time of the step [ms]
+};
+
+/// \brief One step's outcome.
+struct OdometryResult {
+  OdometryStatus status = OdometryStatus::Failed;  ///< see OdometryStatus
+  /// The camera pose in the world: the new one when Ok or FirstFrame, the
+  /// last good one otherwise (never a jump).
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+  OdometryDiagnostics diagnostics;  ///< why
+};
+
+/**
+ * \brief RGB-D odometry over a sequence of frames (one camera, fixed intrinsics).
+ *
+ * Not thread-safe; one object per sequence. Frames whose intrinsics
+ * differ from the first frame's are refused (std::invalid_argument).
+ */
+class Odometry {
+ public:
+  /// \throws std::invalid_argument naming the setting that is invalid (validate()).
+  explicit Odometry(const OdometrySettings& settings = {});
+  ~Odometry();
+  Odometry(const Odometry&) = delete;
+  Odometry& operator=(const Odometry&) = delete;
+  Odometry(Odometry&&) noexcept;
+  Odometry& operator=(Odometry&&) noexcept;
+
+  /**
+   * \brief One frame: its pose from the motion since the reference frame.
+   * \param frame        depth [m] (colour for the `rgbd` methods), intrinsics; its
+   *                     wMc is read only on the first frame (the start pose).
+   * \param object_depth the object's nearest depth in the previous frame's camera [m]:
+   *                     with OdometrySettings::mask, pixels nearer than it minus
+   *                     mask_margin are left out (hands, occluders). None: no mask.
+   * \throws std::invalid_argument when the frame's buffers disagree with its
+   *         intrinsics or the intrinsics change.
+   */
+  OdometryResult step(const RgbdFrame& frame, std::optional<double> object_depth = std::nullopt);
+
+  /// \brief Forgets every frame: the next one is a first frame.
+  void reset();
+  /// \brief The current pose (the last good one) [m]; identity before the first frame.
+  [[nodiscard]] const Eigen::Isometry3d& wMc() const;
+  /// \brief The settings it runs with.
+  [[nodiscard]] const OdometrySettings& settings() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// \brief Throws std::invalid_argument naming the first invalid setting and its value.
+void validate(const OdometrySettings& settings);
+/// \brief The settings table: names, types, defaults, units, docs and parsers.
+[[nodiscard]] const SettingsTable<OdometrySettings>& odometry_settings_table();
+
+/// \brief The method's word: icp, rgbd_icp, fast_icp, rgbd.
+[[nodiscard]] const char* to_string(OdometryMethod method);
+/// \brief The status's word: ok, first_frame, failed, implausible.
+[[nodiscard]] const char* to_string(OdometryStatus status);
+/// \brief The method a word names.
+/// \throws std::invalid_argument naming `what` and listing the words.
+[[nodiscard]] OdometryMethod parse_method(const std::string& what, const std::string& word);
+
+}  // namespace ofv::odometry

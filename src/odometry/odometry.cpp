@@ -1,0 +1,322 @@
+// RGB-D odometry on OpenCV's rgbd module (ofv/odometry/odometry.h).
+#include "ofv/odometry/odometry.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/rgbd.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ofv::odometry {
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+// Pixel step of the inlier count: 1/16 of the pixels give the fraction
+// within a percent at a tenth of the cost of the odometry itself.
+constexpr int kInlierStride = 4;
+
+cv::Ptr<cv::rgbd::Odometry> make_odometry(const OdometrySettings& s, const CameraIntrinsics& k) {
+  cv::Mat K = (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
+  const auto min_depth = static_cast<float>(s.min_depth);
+  const auto max_depth = static_cast<float>(s.max_depth);
+  const auto diff = static_cast<float>(s.max_depth_diff);
+  const auto part = static_cast<float>(s.max_points_part);
+  // OpenCV's own motion bound turns a large motion into a failure; ours
+  // (max_translation, max_rotation) makes it Implausible, so OpenCV's is lifted.
+  constexpr double kUnbounded = 1e3;
+  // OpenCV's default is 7, 7, 7, 10 from the finest level to the coarsest.
+  const int n = s.iterations;
+  const std::vector<int> iterations = {n, n, n, n + n / 2};
+  switch (s.method) {
+    case OdometryMethod::Icp: {
+      auto o = cv::rgbd::ICPOdometry::create(K, min_depth, max_depth, diff, part, iterations);
+      o->setMaxTranslation(kUnbounded);
+      o->setMaxRotation(kUnbounded);
+      return o;
+    }
+    case OdometryMethod::RgbdIcp: {
+      auto o = cv::rgbd::RgbdICPOdometry::create(K, min_depth, max_depth, diff, part, iterations);
+      o->setMaxTranslation(kUnbounded);
+      o->setMaxRotation(kUnbounded);
+      return o;
+    }
+    case OdometryMethod::FastIcp:
+      return cv::rgbd::FastICPOdometry::create(K, diff, static_cast<float>(30.0 * kDegree), 0.04f, 4.5f, 7,
+                                               iterations);
+    case OdometryMethod::Rgbd: {
+      auto o = cv::rgbd::RgbdOdometry::create(K, min_depth, max_depth, diff, iterations, {}, part);
+      o->setMaxTranslation(kUnbounded);
+      o->setMaxRotation(kUnbounded);
+      return o;
+    }
+  }
+  throw std::invalid_argument("odometry: unknown method");
+}
+
+bool same(const CameraIntrinsics& a, const CameraIntrinsics& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx &&
+         a.cy == b.cy;
+}
+
+/// The rotation's angle [rad].
+double angle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
+
+}  // namespace
+
+struct Odometry::Impl {
+  OdometrySettings settings;
+  cv::Ptr<cv::rgbd::Odometry> odometry;
+  CameraIntrinsics intrinsics;
+  bool started = false;
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  // the last good pose
+  Eigen::Isometry3d wMk = Eigen::Isometry3d::Identity();  // the reference frame's pose
+  Eigen::Isometry3d kMc = Eigen::Isometry3d::Identity();  // the last good pose in the reference frame
+  cv::Ptr<cv::rgbd::OdometryFrame> reference;
+
+  explicit Impl(const OdometrySettings& s) : settings(s) {}
+
+  [[nodiscard]] bool needs_colour() const {
+    return settings.method == OdometryMethod::Rgbd || settings.method == OdometryMethod::RgbdIcp;
+  }
+
+  /// The frame as OpenCV takes it: depth [m] with NaN where missing, the
+  /// mask of the pixels used, grey image for the photometric methods.
+  cv::Ptr<cv::rgbd::OdometryFrame> convert(const RgbdFrame& frame, std::optional<double> object_depth,
+                                           OdometryDiagnostics& d) const {
+    const int w = frame.intrinsics.width;
+    const int h = frame.intrinsics.height;
+    cv::Mat depth(h, w, CV_32FC1);
+    cv::Mat mask(h, w, CV_8UC1);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const bool masking = settings.mask && object_depth && std::isfinite(*object_depth);
+    const double nearest = masking ? *object_depth - settings.mask_margin : 0.0;
+    long used = 0;
+    long masked = 0;
+    for (int v = 0; v < h; ++v) {
+      auto* drow = depth.ptr<float>(v);
+      auto* mrow = mask.ptr<std::uint8_t>(v);
+      for (int u = 0; u < w; ++u) {
+        const float z = frame.depth[frame.index(u, v)];
+        const bool valid = z >= settings.min_depth && z <= settings.max_depth;  // NaN fails
+        drow[u] = valid ? z : nan;
+        const bool hidden = valid && masking && z < nearest;
+        mrow[u] = valid && !hidden ? 255 : 0;
+        used += valid && !hidden ? 1 : 0;
+        masked += hidden ? 1 : 0;
+      }
+    }
+    const double pixels = static_cast<double>(w) * h;
+    d.valid_fraction = static_cast<double>(used) / pixels;
+    d.masked_fraction = static_cast<double>(masked) / pixels;
+    cv::Mat grey;
+    if (needs_colour()) {
+      if (frame.rgb.size() == static_cast<std::size_t>(w) * h * 3) {
+        const cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+        cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+      } else {
+        grey = cv::Mat::zeros(h, w, CV_8UC1);
+      }
+    }
+    return cv::rgbd::OdometryFrame::create(grey, depth, mask);
+  }
+
+  /// Of the used pixels of `src` (sampled), those whose point, moved by `motion` (kMc),
+  /// falls on a reference pixel within max_depth_diff; and their RMS difference.
+  void inliers(const cv::rgbd::OdometryFrame& src, const cv::rgbd::OdometryFrame& ref, const Eigen::Isometry3d& motion,
+               OdometryDiagnostics& d) const {
+    const CameraIntrinsics& k = intrinsics;
+    const Eigen::Matrix3f R = motion.linear().cast<float>();
+    const Eigen::Vector3f t = motion.translation().cast<float>();
+    long samples = 0;
+    long matched = 0;
+    double sum = 0.0;
+    for (int v = 0; v < k.height; v += kInlierStride) {
+      const auto* zrow = src.depth.ptr<float>(v);
+      const auto* mrow = src.mask.ptr<std::uint8_t>(v);
+      for (int u = 0; u < k.width; u += kInlierStride) {
+        if (mrow[u] == 0) continue;
+        ++samples;
+        const float z = zrow[u];
+        const Eigen::Vector3f p(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
+        const Eigen::Vector3f q = R * p + t;
+        if (!(q.z() > 0.0f)) continue;
+        const double uq = k.fx * q.x() / q.z() + k.cx;
+        const double vq = k.fy * q.y() / q.z() + k.cy;
+        const long ui = std::lround(uq);
+        const long vi = std::lround(vq);
+        if (!(ui >= 0 && ui < k.width && vi >= 0 && vi < k.height)) continue;
+        if (ref.mask.at<std::uint8_t>(static_cast<int>(vi), static_cast<int>(ui)) == 0) continue;
+        const double diff = ref.depth.at<float>(static_cast<int>(vi), static_cast<int>(ui)) - q.z();
+        if (std::abs(diff) <= settings.max_depth_diff) {
+          ++matched;
+          sum += diff * diff;
+        }
+      }
+    }
+    d.inlier_fraction = samples > 0 ? static_cast<double>(matched) / static_cast<double>(samples) : 0.0;
+    d.residual = matched > 0 ? std::sqrt(sum / static_cast<double>(matched)) : 0.0;
+  }
+};
+
+Odometry::Odometry(const OdometrySettings& settings) {
+  validate(settings);
+  impl_ = std::make_unique<Impl>(settings);
+}
+Odometry::~Odometry() = default;
+Odometry::Odometry(Odometry&&) noexcept = default;
+Odometry& Odometry::operator=(Odometry&&) noexcept = default;
+
+void Odometry::reset() {
+  impl_->started = false;
+  impl_->reference.release();
+  impl_->wMc = impl_->wMk = impl_->kMc = Eigen::Isometry3d::Identity();
+}
+
+const Eigen::Isometry3d& Odometry::wMc() const { return impl_->wMc; }
+const OdometrySettings& Odometry::settings() const { return impl_->settings; }
+
+OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> object_depth) {
+  const auto start = std::chrono::steady_clock::now();
+  Impl& m = *impl_;
+  const CameraIntrinsics& k = frame.intrinsics;
+  const std::size_t pixels = static_cast<std::size_t>(std::max(k.width, 0)) * static_cast<std::size_t>(std::max(k.height, 0));
+  if (k.width <= 0 || k.height <= 0 || frame.depth.size() != pixels) {
+    throw std::invalid_argument("odometry: the frame's depth has " + std::to_string(frame.depth.size()) +
+                                " values, its intrinsics say " + std::to_string(k.width) + "x" +
+                                std::to_string(k.height));
+  }
+  if (m.started && !same(k, m.intrinsics)) {
+    throw std::invalid_argument("odometry: the frame's intrinsics differ from the first frame's");
+  }
+  OdometryResult result;
+  const auto finish = [&](OdometryStatus status) {
+    result.status = status;
+    result.wMc = m.wMc;
+    result.diagnostics.ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  };
+  OdometryDiagnostics& d = result.diagnostics;
+  if (!m.started) {
+    m.intrinsics = k;
+    m.odometry = make_odometry(m.settings, k);
+  }
+  cv::Ptr<cv::rgbd::OdometryFrame> current = m.convert(frame, object_depth, d);
+  if (!m.started) {
+    // The first frame is a reference only if it can be one; until then
+    // every frame is a first frame, at the source's pose.
+    m.wMc = frame.wMc;
+    if (d.valid_fraction < m.settings.min_valid_fraction) return finish(OdometryStatus::Failed);
+    m.started = true;
+    m.wMk = m.wMc;
+    m.kMc = Eigen::Isometry3d::Identity();
+    m.reference = current;
+    d.keyframe = true;
+    return finish(OdometryStatus::FirstFrame);
+  }
+  if (d.valid_fraction < m.settings.min_valid_fraction) return finish(OdometryStatus::Failed);
+
+  // The last motion as the first guess: the camera moves smoothly.
+  cv::Mat init(4, 4, CV_64FC1);
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) init.at<double>(r, c) = m.kMc.matrix()(r, c);
+  }
+  cv::Mat Rt;
+  bool ok = false;
+  try {
+    ok = m.odometry->compute(current, m.reference, Rt, init);
+  } catch (const cv::Exception&) {
+    return finish(OdometryStatus::Failed);  // e.g. too few points for a level of the pyramid
+  }
+  d.converged = ok && Rt.rows == 4 && Rt.cols == 4;
+  // The frame had pixels enough: no motion that fits means it does not fit the reference.
+  if (!d.converged) return finish(OdometryStatus::Implausible);
+
+  Eigen::Matrix4d T;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) T(r, c) = Rt.at<double>(r, c);
+  }
+  if (!T.allFinite()) {
+    d.translation = d.rotation = std::numeric_limits<double>::quiet_NaN();
+    return finish(OdometryStatus::Implausible);
+  }
+  // OpenCV composes its increments without re-orthonormalising: the
+  // rotation drifts off SO(3) and, composed frame after frame, scales the pose.
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  d.orthonormality = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d Rn = svd.matrixU() * svd.matrixV().transpose();
+  if (Rn.determinant() < 0.0) {
+    Eigen::Matrix3d U = svd.matrixU();
+    U.col(2) = -U.col(2);
+    Rn = U * svd.matrixV().transpose();
+  }
+  Eigen::Isometry3d kMc = Eigen::Isometry3d::Identity();
+  kMc.linear() = Rn;
+  kMc.translation() = T.topRightCorner<3, 1>();
+
+  const Eigen::Isometry3d wMc = m.wMk * kMc;
+  const Eigen::Isometry3d motion = m.wMc.inverse() * wMc;  // from the last good pose
+  d.translation = motion.translation().norm();
+  d.rotation = angle(motion.linear()) / kDegree;
+  m.inliers(*current, *m.reference, kMc, d);
+  if (d.translation > m.settings.max_translation || d.rotation > m.settings.max_rotation ||
+      d.inlier_fraction < m.settings.min_inlier_fraction) {
+    return finish(OdometryStatus::Implausible);
+  }
+  m.wMc = wMc;
+  m.kMc = kMc;
+  if (!m.settings.keyframe || kMc.translation().norm() > m.settings.keyframe_translation ||
+      angle(kMc.linear()) > m.settings.keyframe_rotation * kDegree) {
+    m.reference = current;
+    m.wMk = wMc;
+    m.kMc = Eigen::Isometry3d::Identity();
+    d.keyframe = true;
+  }
+  return finish(OdometryStatus::Ok);
+}
+
+const char* to_string(OdometryMethod method) {
+  switch (method) {
+    case OdometryMethod::Icp:
+      return "icp";
+    case OdometryMethod::RgbdIcp:
+      return "rgbd_icp";
+    case OdometryMethod::FastIcp:
+      return "fast_icp";
+    case OdometryMethod::Rgbd:
+      return "rgbd";
+  }
+  return "?";
+}
+
+const char* to_string(OdometryStatus status) {
+  switch (status) {
+    case OdometryStatus::Ok:
+      return "ok";
+    case OdometryStatus::FirstFrame:
+      return "first_frame";
+    case OdometryStatus::Failed:
+      return "failed";
+    case OdometryStatus::Implausible:
+      return "implausible";
+  }
+  return "?";
+}
+
+OdometryMethod parse_method(const std::string& what, const std::string& word) {
+  return parse_word<OdometryMethod>(what, word,
+                                    {{"icp", OdometryMethod::Icp},
+                                     {"rgbd_icp", OdometryMethod::RgbdIcp},
+                                     {"fast_icp", OdometryMethod::FastIcp},
+                                     {"rgbd", OdometryMethod::Rgbd}});
+}
+
+}  // namespace ofv::odometry

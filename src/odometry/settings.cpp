@@ -1,0 +1,91 @@
+// The odometry's settings table and validation (ofv/odometry/odometry.h).
+#include "ofv/odometry/odometry.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace ofv::odometry {
+
+namespace {
+
+using S = OdometrySettings;
+
+/// A row for a number in (lo, hi] (or [lo, hi]) of the member `field`.
+void number_row(SettingsTable<S>& t, const char* name, double S::*field, const char* unit, const char* doc,
+                double lo, double hi, bool lo_open) {
+  const S d;
+  t.add({name, "number", format_number(d.*field), unit, doc},
+        [=](S& s, const std::string& v) { s.*field = parse_number(name, v, lo, hi, lo_open); },
+        [=](const S& s) { return format_number(s.*field); });
+}
+
+void bool_row(SettingsTable<S>& t, const char* name, bool S::*field, const char* doc) {
+  const S d;
+  t.add({name, "bool", format_bool(d.*field), "", doc},
+        [=](S& s, const std::string& v) { s.*field = parse_bool(name, v); },
+        [=](const S& s) { return format_bool(s.*field); });
+}
+
+}  // namespace
+
+const SettingsTable<OdometrySettings>& odometry_settings_table() {
+  static const SettingsTable<S> table = [] {
+    const S d;
+    SettingsTable<S> t;
+    t.add({"odometry", "icp | rgbd_icp | fast_icp | rgbd", to_string(d.method), "",
+           "OpenCV's RGB-D odometry: point-to-plane ICP, ICP with photometric terms, KinectFusion's ICP, "
+           "photometric only (needs texture)"},
+          [](S& s, const std::string& v) { s.method = parse_method("odometry", v); },
+          [](const S& s) { return std::string(to_string(s.method)); });
+    bool_row(t, "keyframe", &S::keyframe,
+             "match each frame against the last keyframe (false: against the previous frame, which drifts more)");
+    number_row(t, "keyframe_translation", &S::keyframe_translation, "m",
+               "a frame becomes the keyframe when the camera moved more than this from the last one", 0.0, 1.0, false);
+    number_row(t, "keyframe_rotation", &S::keyframe_rotation, "deg",
+               "... or turned more than this from it", 0.0, 90.0, false);
+    number_row(t, "max_translation", &S::max_translation, "m",
+               "a step moving the camera more than this from the last pose is implausible (the pose stays)", 0.0,
+               10.0, true);
+    number_row(t, "max_rotation", &S::max_rotation, "deg",
+               "a step turning the camera more than this from the last pose is implausible (the pose stays)", 0.0,
+               180.0, true);
+    number_row(t, "min_valid_fraction", &S::min_valid_fraction, "",
+               "a frame with fewer of its pixels usable (depth in range, not masked) fails", 0.0, 1.0, false);
+    number_row(t, "min_inlier_fraction", &S::min_inlier_fraction, "",
+               "a step after which fewer of the used pixels fall on the reference within max_depth_diff is "
+               "implausible",
+               0.0, 1.0, false);
+    number_row(t, "max_depth_diff", &S::max_depth_diff, "m",
+               "pixels of the two frames match when their depths differ by at most this (OpenCV's maxDepthDiff)", 0.0,
+               1.0, true);
+    number_row(t, "min_depth", &S::min_depth, "m", "pixels nearer than this are not used", 0.0, 100.0, false);
+    number_row(t, "max_depth", &S::max_depth, "m", "pixels farther than this are not used", 0.0, 100.0, true);
+    t.add({"iterations", "integer", std::to_string(d.iterations), "",
+           "iterations at each of the 3 finer pyramid levels (1.5x at the coarsest; OpenCV's default 7)"},
+          [](S& s, const std::string& v) { s.iterations = static_cast<int>(parse_integer("iterations", v, 1, 1000)); },
+          [](const S& s) { return std::to_string(s.iterations); });
+    number_row(t, "max_points_part", &S::max_points_part, "",
+               "share of the pixels the ICP and RGB-D methods sample (OpenCV's maxPointsPart)", 0.0, 1.0, true);
+    bool_row(t, "mask", &S::mask,
+             "leave out pixels nearer than the object's depth in the previous frame minus mask_margin (hands, "
+             "occluders)");
+    number_row(t, "mask_margin", &S::mask_margin, "m",
+               "see mask: how much nearer than the object a pixel must be to be left out", 0.0, 10.0, false);
+    return t;
+  }();
+  return table;
+}
+
+void validate(const OdometrySettings& s) {
+  // Every value goes back through its row's parser: one place for the bounds.
+  for (const auto& [name, value] : odometry_settings_table().values(s)) {
+    S scratch;
+    odometry_settings_table().set(scratch, name, value);
+  }
+  if (!(s.min_depth < s.max_depth)) {
+    throw std::invalid_argument("setting 'min_depth' must be below max_depth (" + format_number(s.max_depth) +
+                                "), got " + format_number(s.min_depth));
+  }
+}
+
+}  // namespace ofv::odometry

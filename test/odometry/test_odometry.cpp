@@ -1,0 +1,192 @@
+// RGB-D odometry on frames the simulator renders (with its sensor noise) at
+// known camera poses: the motion it recovers and the statuses it reports.
+#include "ofv/odometry/odometry.h"
+#include "ofv/sim/renderer.h"
+#include "ofv/sim/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace ofv::odometry {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+// Tolerances: one step of 1 cm or 1 degree (3x a scenario's largest
+// motion per frame) within 10 % of the step, and 0.1 degree: the issue's
+// goal per frame. Measured with the renderer's noise (seeds 0, 1): ICP
+// 0.05-0.47 mm (the largest for 1 degree about y, the scene 0.5 m away),
+// rgbd_icp 0.75 mm, fast_icp 0.30 mm; 0.004-0.054 degree.
+constexpr double kTranslationTolerance = 0.001;  // [m]
+constexpr double kRotationTolerance = 0.1;        // [deg]
+
+/// A scenario's first frame rendered from its start pose moved by `cMc2` (in the camera's frame).
+struct Scene {
+  sim::Scenario scenario;
+  sim::Renderer renderer;
+  explicit Scene(const std::string& name) : scenario(sim::load_scenario(name)), renderer(scenario) {
+    renderer.set_time(0.0);
+  }
+  RgbdFrame frame(const Eigen::Isometry3d& cMc2, long index) const {
+    return renderer.render(scenario.wMc_start * cMc2, index).frame;
+  }
+};
+
+/// The pose error of `wMc` against `wMc_true`: {translation [m], rotation [deg]}.
+std::pair<double, double> error(const Eigen::Isometry3d& wMc, const Eigen::Isometry3d& wMc_true) {
+  const Eigen::Isometry3d E = wMc_true.inverse() * wMc;
+  return {E.translation().norm(), Eigen::AngleAxisd(E.linear()).angle() / kDegree};
+}
+
+void expect_recovers(OdometryMethod method, const Eigen::Isometry3d& cMc2) {
+  Scene scene("dvd-static");
+  OdometrySettings s;
+  s.method = method;
+  // A 1 cm step in one frame is 3x the scenarios' largest camera motion per
+  // frame, and along the table only the case's edges hold ICP: with
+  // OpenCV's 7 iterations it stops at 8.5 of the 10 mm, with 15 within 0.1 mm.
+  s.iterations = 15;
+  Odometry odometry(s);
+  const RgbdFrame first = scene.frame(Eigen::Isometry3d::Identity(), 0);
+  const OdometryResult r0 = odometry.step(first);
+  EXPECT_EQ(r0.status, OdometryStatus::FirstFrame);
+  EXPECT_TRUE(r0.wMc.isApprox(first.wMc));
+  const RgbdFrame second = scene.frame(cMc2, 1);
+  const OdometryResult r1 = odometry.step(second);
+  ASSERT_EQ(r1.status, OdometryStatus::Ok) << to_string(r1.status) << " inliers " << r1.diagnostics.inlier_fraction;
+  const auto [t, r] = error(r1.wMc, second.wMc);
+  EXPECT_LT(t, kTranslationTolerance);
+  EXPECT_LT(r, kRotationTolerance);
+  // The pose is a rigid motion: its rotation is orthonormal to rounding.
+  EXPECT_LT((r1.wMc.linear().transpose() * r1.wMc.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_GT(r1.diagnostics.inlier_fraction, s.min_inlier_fraction);
+  std::cout << to_string(method) << ": error " << t * 1000 << " mm, " << r << " deg, "
+            << r1.diagnostics.ms << " ms, inliers " << r1.diagnostics.inlier_fraction << '\n';
+}
+
+TEST(Odometry, RecoversNoMotion) { expect_recovers(OdometryMethod::Icp, Eigen::Isometry3d::Identity()); }
+
+TEST(Odometry, RecoversOneCentimetreTranslation) {
+  expect_recovers(OdometryMethod::Icp, Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)));
+  expect_recovers(OdometryMethod::Icp, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.006, 0.008)));
+}
+
+TEST(Odometry, RecoversOneDegreeRotation) {
+  expect_recovers(OdometryMethod::Icp, Eigen::Isometry3d(Eigen::AngleAxisd(kDegree, Eigen::Vector3d::UnitY())));
+  expect_recovers(OdometryMethod::Icp, Eigen::Isometry3d(Eigen::AngleAxisd(kDegree, Eigen::Vector3d::UnitZ())));
+}
+
+TEST(Odometry, OtherIcpMethodsRecoverTranslation) {
+  expect_recovers(OdometryMethod::RgbdIcp, Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)));
+  expect_recovers(OdometryMethod::FastIcp, Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)));
+}
+
+TEST(Odometry, StartsAtTheFirstFramesPoseAndComposes) {
+  // Three steps of 1 cm along the camera's x: the pose composes them, and a
+  // keyframe is taken once the camera is more than 3 cm from the first.
+  Scene scene("dvd-static");
+  Odometry odometry;
+  ASSERT_EQ(odometry.step(scene.frame(Eigen::Isometry3d::Identity(), 0)).status, OdometryStatus::FirstFrame);
+  RgbdFrame frame;
+  OdometryResult r;
+  int keyframes = 0;
+  for (int k = 1; k <= 4; ++k) {
+    frame = scene.frame(Eigen::Isometry3d(Eigen::Translation3d(0.01 * k, 0.0, 0.0)), k);
+    r = odometry.step(frame);
+    ASSERT_EQ(r.status, OdometryStatus::Ok) << "step " << k;
+    keyframes += r.diagnostics.keyframe ? 1 : 0;
+  }
+  EXPECT_EQ(keyframes, 1);  // at 4 cm
+  EXPECT_LT(error(r.wMc, frame.wMc).first, 4 * kTranslationTolerance);
+}
+
+TEST(Odometry, BlankDepthFails) {
+  Scene scene("dvd-static");
+  Odometry odometry;
+  const OdometryResult first = odometry.step(scene.frame(Eigen::Isometry3d::Identity(), 0));
+  RgbdFrame blank = scene.frame(Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)), 1);
+  std::fill(blank.depth.begin(), blank.depth.end(), 0.0f);
+  const OdometryResult r = odometry.step(blank);
+  EXPECT_EQ(r.status, OdometryStatus::Failed);
+  EXPECT_EQ(r.diagnostics.valid_fraction, 0.0);
+  EXPECT_TRUE(r.wMc.isApprox(first.wMc));  // the last good pose, not a jump
+}
+
+TEST(Odometry, JumpIsImplausibleAndKeepsThePose) {
+  Scene scene("dvd-static");
+  Odometry odometry;
+  const OdometryResult first = odometry.step(scene.frame(Eigen::Isometry3d::Identity(), 0));
+  // 30 cm back: the depths differ by more than max_depth_diff. (30 cm along
+  // the table is not seen: the plane fits itself, the case's pixels are few.)
+  const OdometryResult r = odometry.step(scene.frame(Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, -0.3)), 1));
+  EXPECT_EQ(r.status, OdometryStatus::Implausible) << to_string(r.status);
+  EXPECT_TRUE(r.wMc.isApprox(first.wMc));
+  // The odometry goes on from the last good pose: a frame near it is Ok again.
+  const OdometryResult back = odometry.step(scene.frame(Eigen::Isometry3d(Eigen::Translation3d(0.005, 0.0, 0.0)), 2));
+  EXPECT_EQ(back.status, OdometryStatus::Ok);
+}
+
+TEST(Odometry, OtherSceneIsImplausible) {
+  Scene scene("dvd-static");
+  Scene other("cloth-occluder");
+  Odometry odometry;
+  const OdometryResult first = odometry.step(scene.frame(Eigen::Isometry3d::Identity(), 0));
+  // The other scene from a viewpoint 20 cm back and turned: nothing of the first frame's geometry.
+  const OdometryResult r = odometry.step(
+      other.frame(Eigen::Isometry3d(Eigen::AngleAxisd(20 * kDegree, Eigen::Vector3d::UnitX())), 1));
+  EXPECT_NE(r.status, OdometryStatus::Ok) << to_string(r.status);
+  EXPECT_EQ(r.status, OdometryStatus::Implausible) << to_string(r.status);
+  EXPECT_TRUE(r.wMc.isApprox(first.wMc));
+}
+
+TEST(Odometry, FirstFrameWithoutDepthKeepsTrying) {
+  Scene scene("dvd-static");
+  Odometry odometry;
+  RgbdFrame blank = scene.frame(Eigen::Isometry3d::Identity(), 0);
+  std::fill(blank.depth.begin(), blank.depth.end(), 0.0f);
+  EXPECT_EQ(odometry.step(blank).status, OdometryStatus::Failed);
+  EXPECT_EQ(odometry.step(scene.frame(Eigen::Isometry3d::Identity(), 1)).status, OdometryStatus::FirstFrame);
+}
+
+TEST(Odometry, MaskLeavesOutWhatIsNearerThanTheObject) {
+  Scene scene("dvd-static");
+  Odometry odometry;
+  const RgbdFrame frame = scene.frame(Eigen::Isometry3d::Identity(), 0);
+  // Everything nearer than 0.4 m + the margin would be left out.
+  Odometry unmasked;
+  const OdometryResult all = unmasked.step(frame, 0.0);
+  EXPECT_EQ(all.status, OdometryStatus::FirstFrame);
+  EXPECT_EQ(all.diagnostics.masked_fraction, 0.0);
+  // An object 10 m away: every pixel is nearer than it minus the margin.
+  const OdometryResult r = odometry.step(frame, 10.0);
+  EXPECT_EQ(r.status, OdometryStatus::Failed);
+  EXPECT_EQ(r.diagnostics.valid_fraction, 0.0);
+  EXPECT_DOUBLE_EQ(r.diagnostics.masked_fraction, all.diagnostics.valid_fraction);
+  // With the mask off, the same object depth leaves every pixel in.
+  OdometrySettings s;
+  s.mask = false;
+  Odometry off(s);
+  EXPECT_DOUBLE_EQ(off.step(frame, 10.0).diagnostics.valid_fraction, all.diagnostics.valid_fraction);
+}
+
+TEST(OdometrySettings, TableParsesAndValidates) {
+  OdometrySettings s;
+  odometry_settings_table().set(s, "odometry", "fast_icp");
+  EXPECT_EQ(s.method, OdometryMethod::FastIcp);
+  odometry_settings_table().set(s, "keyframe", "false");
+  EXPECT_FALSE(s.keyframe);
+  EXPECT_THROW(odometry_settings_table().set(s, "odometry", "nope"), std::invalid_argument);
+  EXPECT_THROW(odometry_settings_table().set(s, "max_translation", "-1"), std::invalid_argument);
+  s = {};
+  s.min_depth = 5.0;
+  EXPECT_THROW(Odometry{s}, std::invalid_argument);
+  // Every default reads back as itself.
+  const OdometrySettings d;
+  OdometrySettings back;
+  odometry_settings_table().apply(back, odometry_settings_table().values(d));
+  EXPECT_EQ(odometry_settings_table().values(back), odometry_settings_table().values(d));
+}
+
+}  // namespace
+}  // namespace ofv::odometry

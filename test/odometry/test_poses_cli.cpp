@@ -1,0 +1,63 @@
+// `ofv perceive --poses` end to end through the `ofv` binary, on a short
+// recording of a simulated episode (`ofv simulate --record`).
+#include "cli_run.h"
+
+#include "ofv/sources/sequence_files.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+
+namespace ofv {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A 1 s recording of dvd-static, made once per test process.
+const std::string& recording() {
+  static const std::string dir = [] {
+    const std::string d = (fs::path(test::scratch_dir()) / "dvd-static").string();
+    const CommandRun r = run("simulate dvd-static --set duration=1 --no-pictures --record " + d + " --out " + d +
+                             "-episode >/dev/null");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return d;
+  }();
+  return dir;
+}
+
+TEST(PosesCli, OdometryWritesPosesAndPrintsTheErrors) {
+  const std::string out = (fs::path(test::scratch_dir()) / "odometry").string();
+  const CommandRun r = run("perceive " + recording() + " --poses odometry --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto frames = read_pose_file(recording() + "/groundtruth.txt");
+  const auto poses = read_pose_file(out + "/poses.txt");
+  EXPECT_EQ(poses.size(), frames.size());
+  EXPECT_TRUE(fs::exists(out + "/frame_000001.json"));
+  EXPECT_NE(file_text(out + "/frame_000001.json").find("\"odometry\""), std::string::npos);
+  // "ATE 0.41 mm" on stderr: small on a still scene.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex("ATE ([0-9.]+) mm"))) << r.err;
+  EXPECT_LT(std::stod(m[1]), 2.0) << r.err;
+}
+
+TEST(PosesCli, SourcePosesAreTheRecordingsOwn) {
+  const std::string out = (fs::path(test::scratch_dir()) / "source").string();
+  const CommandRun r = run("perceive " + recording() + " --poses source --max-frames 3 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto truth = read_pose_file(recording() + "/groundtruth.txt");
+  const auto poses = read_pose_file(out + "/poses.txt");
+  ASSERT_EQ(poses.size(), 3u);
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_TRUE(poses[k].wMc.isApprox(truth[k].wMc, 1e-9));
+}
+
+TEST(PosesCli, UnknownMethodIsAUsageError) {
+  const CommandRun r = run("perceive " + recording() + " --poses odometry:nope");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--poses"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("fast_icp"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+}  // namespace
+}  // namespace ofv
