@@ -10,8 +10,16 @@
 #include "ofv/perception/perception.h"
 #include "ofv/sources/open_source.h"
 #include "ofv/sources/openni2_source.h"
+#include "ofv/sources/sequence_files.h"
+#ifdef OFV_HAVE_ODOMETRY
+#include "ofv/odometry/evaluation.h"
+#include "ofv/odometry/odometry.h"
+#endif
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <iomanip>
 #include <sstream>
 #include <iostream>
@@ -32,9 +40,17 @@ constexpr const char* kSourceHelp = R"(Sources:
   FILE.oni            an OpenNI2 recording (poses from FILE.oni.poses.txt if present)
   openni2://URI       a live OpenNI2 device (openni2:// alone: the first device)
 
+Camera poses (--poses): `source` the source's own (groundtruth.txt, poses.txt, a robot's);
+`odometry[:METHOD]` RGB-D odometry from the first frame's pose (METHOD icp (default),
+rgbd_icp, fast_icp, rgbd; its settings with --set, `ofv perceive --help-odometry`). With a
+source that has poses of its own (a TUM folder's groundtruth.txt), ATE and RPE against them
+are printed at the end.
+
 Output: with --out DIR, DIR/frame_NNNNNN.json per frame ({"frame", "timestamp", "status",
-"problem" (a scene for 'ofv estimate'), "estimate", "counts", "timings_ms"}) and, with
---pictures, DIR/frame_NNNNNN.png; without --out, one JSON object per line on stdout.
+"pose" (with --poses odometry: its status and diagnostics), "problem" (a scene for 'ofv
+estimate'), "estimate", "counts", "timings_ms"}), DIR/poses.txt (the poses the front end
+used, TUM format) and, with --pictures, DIR/frame_NNNNNN.png; without --out, one JSON
+object per line on stdout.
 A summary goes to stderr. Exit 0 ok, 1 runtime failure, 2 bad input (one line on stderr).
 )";
 
@@ -52,7 +68,38 @@ struct Options {
   double obb_margin = perception::PerceptionSettings{}.obb_margin;
   double max_motion = perception::TrackingSettings{}.max_motion;
   bool no_plane_occluders = false;
+  std::string poses = "source";
+  bool help_odometry = false;
 };
+
+/// The words of --poses, for its error message.
+constexpr const char* kPosesWords = "source, odometry, odometry:icp, odometry:rgbd_icp, odometry:fast_icp, odometry:rgbd";
+
+/// The camera poses asked for: the source's (false) or odometry (true), and its method in `os`.
+/// \throws std::invalid_argument naming --poses and its words.
+#ifdef OFV_HAVE_ODOMETRY
+bool parse_poses(const std::string& text, odometry::OdometrySettings& os) {
+  if (text == "source") return false;
+  const std::string prefix = "odometry";
+  if (text.rfind(prefix, 0) == 0) {
+    if (text.size() == prefix.size()) return true;
+    if (text[prefix.size()] == ':') {
+      try {
+        os.method = odometry::parse_method("--poses", text.substr(prefix.size() + 1));
+        return true;
+      } catch (const std::invalid_argument&) {
+      }
+    }
+  }
+  throw std::invalid_argument("--poses must be one of " + std::string(kPosesWords) + ", got \"" + text + "\"");
+}
+#else
+bool parse_poses(const std::string& text) {
+  if (text == "source") return false;
+  throw std::invalid_argument("--poses must be source (this ofv was built without OpenCV's rgbd module, "
+                              "so without odometry), got \"" + text + "\"");
+}
+#endif
 
 /// The front end's settings: the options, and the estimator's R_seed and R_sphere.
 /// \throws std::invalid_argument naming the option or setting that is invalid.
@@ -93,9 +140,23 @@ Command add_perceive_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_flag("--no-plane-occluders", opt->no_plane_occluders,
                 "The support plane (found in frame 0) is background, not occluders");
+  sub->add_option("--poses", opt->poses,
+                  "Camera poses: source (the source's own) or odometry[:icp|rgbd_icp|fast_icp|rgbd]")
+      ->capture_default_str();
+#ifdef OFV_HAVE_ODOMETRY
+  sub->add_flag("--help-odometry", opt->help_odometry, "Print the odometry's settings (for --set) and exit");
+#endif
   sub->footer(kSourceHelp);
 
   return {sub, [opt]() -> int {
+#ifdef OFV_HAVE_ODOMETRY
+            if (opt->help_odometry) {
+              std::cout << settings_help(odometry::odometry_settings_table().docs());
+              return kOk;
+            }
+            odometry::OdometrySettings odometry_settings;
+            bool use_odometry = false;
+#endif
             std::unique_ptr<FrameSource> source;
             EstimatorParams params;
             EstimatorSettings settings;
@@ -108,10 +169,21 @@ Command add_perceive_command(CLI::App& app) {
               // it; the others are the estimator's.
               std::vector<std::string> estimator_sets;
               std::vector<std::pair<std::string, std::string>> front_end_sets;
+#ifdef OFV_HAVE_ODOMETRY
+              use_odometry = parse_poses(opt->poses, odometry_settings);
+              std::vector<std::pair<std::string, std::string>> odometry_sets;
+#else
+              parse_poses(opt->poses);
+#endif
               for (const std::string& assignment : opt->sets) {
                 const auto eq = assignment.find('=');
                 if (eq != std::string::npos && perception::perception_settings_table().find(assignment.substr(0, eq))) {
                   front_end_sets.emplace_back(assignment.substr(0, eq), assignment.substr(eq + 1));
+#ifdef OFV_HAVE_ODOMETRY
+                } else if (eq != std::string::npos &&
+                           odometry::odometry_settings_table().find(assignment.substr(0, eq))) {
+                  odometry_sets.emplace_back(assignment.substr(0, eq), assignment.substr(eq + 1));
+#endif
                 } else {
                   estimator_sets.push_back(assignment);
                 }
@@ -120,6 +192,10 @@ Command add_perceive_command(CLI::App& app) {
               settings = params.resolve();
               ps = perception_settings(*opt, settings);
               perception::perception_settings_table().apply(ps, front_end_sets);
+#ifdef OFV_HAVE_ODOMETRY
+              odometry::odometry_settings_table().apply(odometry_settings, odometry_sets);
+              odometry::validate(odometry_settings);
+#endif
               source = open_source(opt->source, opt->speed);
               if (!opt->out.empty()) {
                 std::error_code ec;
@@ -142,15 +218,51 @@ Command add_perceive_command(CLI::App& app) {
             // SIGPIPE ignored in main) ends the run cleanly, saying why.
             struct ReaderGone {};
             try {
+              // The poses the front end used, and the source's own to compare them with.
+              std::vector<StampedPose> used, truth;
+              perception::PoseSource pose_source;
+#ifdef OFV_HAVE_ODOMETRY
+              std::map<odometry::OdometryStatus, long> statuses;
+              std::vector<double> odometry_ms;
+              std::unique_ptr<odometry::Odometry> odometry;
+              if (use_odometry) {
+                odometry = std::make_unique<odometry::Odometry>(odometry_settings);
+                pose_source = [&](const RgbdFrame& frame, std::optional<double> object_depth) {
+                  const odometry::OdometryResult r = odometry->step(frame, object_depth);
+                  ++statuses[r.status];
+                  odometry_ms.push_back(r.diagnostics.ms);
+                  perception::FramePose pose;
+                  pose.wMc = r.wMc;
+                  pose.ok = r.status == odometry::OdometryStatus::Ok || r.status == odometry::OdometryStatus::FirstFrame;
+                  pose.source = "odometry";
+                  pose.status = odometry::to_string(r.status);
+                  const odometry::OdometryDiagnostics& d = r.diagnostics;
+                  pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
+                                      {"inlier_fraction", d.inlier_fraction}, {"residual_m", d.residual},
+                                      {"translation_m", d.translation},       {"rotation_deg", d.rotation},
+                                      {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
+                  return pose;
+                };
+              }
+#endif
               const perception::PerceiveSummary summary = perception::perceive(
                   *source, ps, settings, opt->max_frames, [&](const perception::PerceivedFrame& f) {
+                    used.push_back({f.frame.timestamp, f.frame.wMc});
+                    truth.push_back({f.frame.timestamp, f.source_wMc});
                     if (opt->out.empty()) {
                       std::cout << perception::perceived_frame_json(f, params) << '\n' << std::flush;
                       if (!std::cout) throw ReaderGone{};
                     } else {
                       perception::write_perceived_frame(opt->out, f, params, opt->pictures, settings.r_sphere);
                     }
-                  });
+                  }, pose_source);
+              if (!opt->out.empty()) {
+                std::ofstream file(fs::path(opt->out) / "poses.txt");
+                file << "# camera pose wMc the front end used (--poses " << opt->poses << ")\n"
+                     << "# timestamp tx ty tz qx qy qz qw\n";
+                for (const StampedPose& p : used) file << format_pose_line(p.time, p.wMc);
+                if (!file) throw std::runtime_error(opt->out + "/poses.txt: cannot write the poses");
+              }
               std::cerr << "ofv perceive: " << source->describe() << ": " << summary.frames
                         << " frames, " << summary.lost << " lost, front end median "
                         << summary.median_front_end_ms << " ms"
@@ -158,6 +270,31 @@ Command add_perceive_command(CLI::App& app) {
                                                          " bad frame(s) skipped, the last: " + summary.last_bad_frame
                                                    : "")
                         << '\n';
+#ifdef OFV_HAVE_ODOMETRY
+              if (odometry) {
+                std::ostringstream text;
+                text << std::fixed << std::setprecision(2);
+                std::sort(odometry_ms.begin(), odometry_ms.end());
+                text << "ofv perceive: odometry " << odometry::to_string(odometry_settings.method) << ": median "
+                     << (odometry_ms.empty() ? 0.0 : odometry_ms[odometry_ms.size() / 2]) << " ms/frame;";
+                for (const auto& [status, count] : statuses) text << ' ' << odometry::to_string(status) << ' ' << count;
+                std::cerr << text.str() << '\n';
+                // ofv's own recordings and TUM sequences carry ground truth.
+                if (fs::exists(fs::path(opt->source) / "groundtruth.txt")) {
+                  const odometry::TrajectoryErrors e = odometry::trajectory_errors(used, truth);
+                  std::ostringstream line;
+                  line << std::fixed << std::setprecision(2) << "ofv perceive: against groundtruth.txt (" << e.poses
+                       << " poses): ATE " << 1000 * e.ate << " mm (max " << 1000 * e.ate_max
+                       << "); RPE per frame " << 1000 * e.per_frame.translation_rmse << " mm (max "
+                       << 1000 * e.per_frame.translation_max << "), " << std::setprecision(3)
+                       << e.per_frame.rotation_rmse << " deg (max " << e.per_frame.rotation_max
+                       << "); per second " << std::setprecision(2) << 1000 * e.per_second.translation_rmse
+                       << " mm (max " << 1000 * e.per_second.translation_max << "), " << std::setprecision(3)
+                       << e.per_second.rotation_rmse << " deg (max " << e.per_second.rotation_max << ")";
+                  std::cerr << line.str() << '\n';
+                }
+              }
+#endif
               if (summary.scored > 0) {
                 const auto show = [](const std::optional<double>& x, double scale = 1.0) {
                   std::ostringstream text;

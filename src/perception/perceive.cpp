@@ -12,7 +12,8 @@ namespace ofv::perception {
 
 PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
                          const EstimatorSettings& settings, long max_frames,
-                         const std::function<void(const PerceivedFrame&)>& observer) {
+                         const std::function<void(const PerceivedFrame&)>& observer,
+                         const PoseSource& pose_source) {
   Perception perception(ps);
   std::optional<Eigen::Vector3d> previous_view;
   PerceiveSummary summary;
@@ -28,6 +29,7 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
   double sum[kScores] = {};
   long count[kScores] = {};
   BadFrameBudget bad_frames(kMaxBadFramesInRow, kMaxBadFramesPerMinute);
+  std::optional<double> object_depth;  // the object's nearest depth in the last perceived frame's camera
   while (max_frames < 0 || summary.frames < max_frames) {
     PerceivedFrame f;
     // A frame the source cannot read (BadFrame) or the front end refuses is
@@ -40,6 +42,13 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
       f.frame = std::move(*frame);
     } catch (const BadFrame& e) {
       bad = e.what();
+    }
+    if (bad.empty()) {
+      f.source_wMc = f.frame.wMc;
+      if (pose_source) {
+        f.pose = pose_source(f.frame, object_depth);
+        f.frame.wMc = f.pose->wMc;
+      }
     }
     try {
       if (bad.empty()) f.result = perception.process(f.frame);
@@ -54,6 +63,11 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     }
     bad_frames.good();
     f.index = summary.frames;
+    object_depth.reset();
+    if (f.result.status != TrackingStatus::Lost && f.result.problem.positions.cols() > 0) {
+      const Eigen::Isometry3d cMw = f.frame.wMc.inverse();
+      object_depth = (cMw * f.result.problem.positions).row(2).minCoeff();
+    }
     front_end_ms.push_back(f.result.timings.total);
     if (f.result.status != TrackingStatus::Lost) {
       f.result.problem.previous_view = previous_view;

@@ -47,6 +47,14 @@ nlohmann::ordered_json frame_json(const PerceivedFrame& f, const EstimatorParams
   if (!r.message.empty()) {
     j["message"] = r.message;
   }
+  if (f.pose) {  // the pose came from a pose source (odometry): what it said
+    nlohmann::ordered_json pose;
+    pose["source"] = f.pose->source;
+    pose["status"] = f.pose->status;
+    pose["ok"] = f.pose->ok;
+    for (const auto& [name, value] : f.pose->diagnostics) pose[name] = value;
+    j["pose"] = pose;
+  }
   // The problem as the estimator got it (previous_view included) only when it ran.
   j["problem"] =
       f.estimate ? scene_to_json(Scene{r.problem, params}) : nlohmann::ordered_json(nullptr);

@@ -25,13 +25,41 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace ofv::perception {
+
+/**
+ * \brief A frame's camera pose from a pose source other than the frame's
+ *        own (perceive()'s `pose_source`, e.g. RGB-D odometry).
+ */
+struct FramePose {
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< the pose the front end gets [m]
+  /// False when the source could not tell this frame's pose: `wMc` is then
+  /// its last good one, never a jump.
+  bool ok = true;
+  std::string source;  ///< the source's word, for the records (`odometry`)
+  std::string status;  ///< its word for this frame, for the records (`ok`, `failed`, ...)
+  std::vector<std::pair<std::string, double>> diagnostics;  ///< numbers for the records, in order
+};
+
+/**
+ * \brief Gives a frame's camera pose before the front end runs. Called once
+ *        per frame, in order, with the frame as the source read it and the
+ *        object's nearest depth in the previous frame's camera [m] (none
+ *        before the object is found or when it was lost).
+ */
+using PoseSource = std::function<FramePose(const RgbdFrame& frame, std::optional<double> object_depth)>;
 
 /// \brief One frame as perceive() saw it: what the front end found and the view estimated.
 struct PerceivedFrame {
   long index = 0;   ///< position in the sequence, from 0
-  RgbdFrame frame;  ///< the frame as the source gave it
+  RgbdFrame frame;  ///< the frame as the source gave it, with the pose the front end used (`wMc`)
+  /// With a pose source: what it said, and the pose the frame source gave
+  /// (ground truth for ofv's recordings) in `source_wMc`.
+  std::optional<FramePose> pose;
+  Eigen::Isometry3d source_wMc = Eigen::Isometry3d::Identity();  ///< the frame source's own pose [m]
   /// The front end's result. When the object is not lost, `result.problem`
   /// is exactly the estimator's input: its `previous_view` is the t_f of
   /// the last frame that had an estimate (none before the first).
@@ -86,13 +114,17 @@ struct PerceiveSummary {
  * \param settings   the estimator's settings.
  * \param max_frames stop after this many frames; negative: no limit.
  * \param observer   called with every frame once it is perceived (may be empty).
+ * \param pose_source when not empty, gives each frame's pose before the front
+ *        end sees it (PoseSource); a pose it marks not ok is still used (its
+ *        last good one) and recorded in PerceivedFrame::pose.
  * \throws std::invalid_argument for invalid settings or a frame whose buffers
  *         disagree with its intrinsics; whatever `source` and `observer` throw
  *         (std::runtime_error when a device or file fails mid-way).
  */
 PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
                          const EstimatorSettings& settings, long max_frames,
-                         const std::function<void(const PerceivedFrame&)>& observer);
+                         const std::function<void(const PerceivedFrame&)>& observer,
+                         const PoseSource& pose_source = {});
 
 }  // namespace ofv::perception
 
