@@ -115,7 +115,9 @@ class Odometry {
   ~Odometry();
   Odometry(const Odometry&) = delete;
   Odometry& operator=(const Odometry&) = delete;
+  /// \brief Moves the state (reference frame, pose) of another sequence's odometry.
   Odometry(Odometry&&) noexcept;
+  /// \brief Moves the state (reference frame, pose) of another sequence's odometry.
   Odometry& operator=(Odometry&&) noexcept;
 
   /**
