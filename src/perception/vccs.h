@@ -3,8 +3,11 @@
 //
 // The algorithm, one frame:
 //  1. Voxels. The cloud's points hashed on cells of `voxel_resolution`
-//     (points sharing a cell are averaged: position and colour), with the
-//     26-neighbourhood of every voxel as index lists.
+//     (points sharing a cell are averaged: position and colour). Two face
+//     neighbours of one colour whose means are within 0.4 voxel across their
+//     common face are one surface patch the face split (a surface lying
+//     along it, both sides taken as its noise decides): they become one
+//     voxel. The 26-neighbourhood of every voxel as index lists.
 //  2. Voxel normals. The smallest principal axis of the voxels within two
 //     rings of neighbours (the voxel, its 26-neighbours and theirs, a voxel
 //     counted once per path to it, as VCCS counts them), turned to face the
