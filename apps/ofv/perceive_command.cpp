@@ -18,7 +18,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <iomanip>
 #include <sstream>
@@ -257,11 +256,8 @@ Command add_perceive_command(CLI::App& app) {
                     }
                   }, pose_source);
               if (!opt->out.empty()) {
-                std::ofstream file(fs::path(opt->out) / "poses.txt");
-                file << "# camera pose wMc the front end used (--poses " << opt->poses << ")\n"
-                     << "# timestamp tx ty tz qx qy qz qw\n";
-                for (const StampedPose& p : used) file << format_pose_line(p.time, p.wMc);
-                if (!file) throw std::runtime_error(opt->out + "/poses.txt: cannot write the poses");
+                write_pose_file((fs::path(opt->out) / "poses.txt").string(), used,
+                                "camera pose wMc the front end used (--poses " + opt->poses + ")");
               }
               std::cerr << "ofv perceive: " << source->describe() << ": " << summary.frames
                         << " frames, " << summary.lost << " lost, front end median "

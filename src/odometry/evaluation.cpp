@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <stdexcept>
 
 namespace ofv::odometry {
@@ -98,13 +97,6 @@ TrajectoryErrors trajectory_errors(const std::vector<StampedPose>& estimate, con
   e.per_frame = relative_pose_error(estimate, truth, 1, 0.0, max_time_difference);
   e.per_second = relative_pose_error(estimate, truth, 0, 1.0, max_time_difference);
   return e;
-}
-
-void write_trajectory(const std::string& path, const std::vector<StampedPose>& poses) {
-  std::ofstream file(path);
-  file << "# camera pose wMc\n# timestamp tx ty tz qx qy qz qw\n";
-  for (const StampedPose& p : poses) file << format_pose_line(p.time, p.wMc);
-  if (!file) throw std::runtime_error(path + ": cannot write the trajectory");
 }
 
 }  // namespace ofv::odometry

@@ -115,6 +115,13 @@ std::string format_pose_line(double time, const Eigen::Isometry3d& wMc) {
   return buffer;
 }
 
+void write_pose_file(const std::string& path, const std::vector<StampedPose>& poses, const std::string& what) {
+  std::ofstream file(path);
+  file << "# " << what << "\n# timestamp tx ty tz qx qy qz qw\n";
+  for (const StampedPose& p : poses) file << format_pose_line(p.time, p.wMc);
+  if (!file) throw std::runtime_error(path + ": cannot write the poses");
+}
+
 Eigen::Isometry3d interpolate_pose(const std::vector<StampedPose>& poses, double time) {
   const auto after = std::lower_bound(poses.begin(), poses.end(), time,
                                       [](const StampedPose& p, double t) { return p.time < t; });

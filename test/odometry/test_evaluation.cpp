@@ -1,12 +1,9 @@
 // The TUM benchmark's measures on hand-made trajectories with known errors.
 #include "ofv/odometry/evaluation.h"
 
-#include "scratch.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 
 namespace ofv::odometry {
 namespace {
@@ -93,18 +90,6 @@ TEST(TrajectoryErrors, PosesAreAssociatedByTime) {
   // Beyond max_time_difference there is no pair.
   for (auto& p : estimate) p.time += 10.0;
   EXPECT_TRUE(associate(estimate, truth).empty());
-}
-
-TEST(TrajectoryFile, WritesWhatTheReaderReads) {
-  const auto poses = curve(10);
-  const std::string path = (std::filesystem::path(test::scratch_dir()) / "poses.txt").string();
-  write_trajectory(path, poses);
-  const auto back = read_pose_file(path);
-  ASSERT_EQ(back.size(), poses.size());
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    EXPECT_DOUBLE_EQ(back[k].time, poses[k].time);
-    EXPECT_TRUE(back[k].wMc.isApprox(poses[k].wMc, 1e-12));
-  }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -220,6 +221,26 @@ TEST(SequenceFiles, TextIsParsedAsTheFileIs) {
     EXPECT_LT(std::string(e.what()).size(), 200U);
     EXPECT_NE(std::string(e.what()).find("poses.txt:1"), std::string::npos) << e.what();
   }
+}
+
+TEST(SequenceFiles, APoseFileWrittenReadsBackTheSame) {
+  std::vector<StampedPose> poses;
+  for (int k = 0; k < 10; ++k) {
+    StampedPose p;
+    p.time = k / 30.0;
+    p.wMc = Eigen::Translation3d(0.3 * std::sin(0.1 * k), 0.01 * k, 0.5) *
+            Eigen::AngleAxisd(0.02 * k, Eigen::Vector3d(0.3, 1.0, 0.2).normalized());
+    poses.push_back(p);
+  }
+  const fs::path file = scratch("written_poses.txt");
+  write_pose_file(file.string(), poses, "camera pose wMc");
+  const auto back = read_pose_file(file.string());
+  ASSERT_EQ(back.size(), poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_DOUBLE_EQ(back[k].time, poses[k].time);
+    EXPECT_TRUE(back[k].wMc.isApprox(poses[k].wMc, 1e-12));
+  }
+  EXPECT_THROW(write_pose_file((scratch("no_such_folder") / "poses.txt").string(), poses, "x"), std::runtime_error);
 }
 
 TEST(PcdSequence, HeaderIsCheckedInMemoryAsInTheFile) {

@@ -78,11 +78,4 @@ struct TrajectoryErrors {
                                                  const std::vector<StampedPose>& truth,
                                                  double max_time_difference = 0.02);
 
-/**
- * \brief Writes a TUM trajectory: a comment line, then `timestamp tx ty tz
- *        qx qy qz qw` per pose (ofv::read_pose_file() reads it back).
- * \throws std::runtime_error naming the file when it cannot be written.
- */
-void write_trajectory(const std::string& path, const std::vector<StampedPose>& poses);
-
 }  // namespace ofv::odometry

@@ -72,6 +72,13 @@ struct TimedFile {
 [[nodiscard]] std::string format_pose_line(double time, const Eigen::Isometry3d& wMc);
 
 /**
+ * \brief Writes a TUM pose file: `# ` + `what`, the format's comment line,
+ *        then a format_pose_line() per pose (read_pose_file() reads it back).
+ * \throws std::runtime_error naming the file when it cannot be written.
+ */
+void write_pose_file(const std::string& path, const std::vector<StampedPose>& poses, const std::string& what);
+
+/**
  * \brief The pose at `time`: linear/slerp interpolation between the two
  *        bracketing poses, the nearest end pose outside their range.
  * \pre poses sorted by time and not empty.
