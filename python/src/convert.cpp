@@ -25,14 +25,11 @@ std::string array_shape(const py::array& a) {
 
 bool is_real(const py::handle& h) { return PyFloat_Check(h.ptr()) || (PyLong_Check(h.ptr()) && !PyBool_Check(h.ptr())); }
 
-// A float, or a real number that is not an int or a bool (numpy's float32, say).
+// is_real(), or any other real number but a bool or an array (numpy's float32, say).
 bool is_number(const py::handle& h) {
-  if (PyFloat_Check(h.ptr())) return true;
-  if (PyBool_Check(h.ptr()) || py::isinstance<py::array>(h)) return false;
-  return PyLong_Check(h.ptr()) || py::isinstance(h, py::module_::import("numbers").attr("Real"));
+  return is_real(h) || (!PyBool_Check(h.ptr()) && !py::isinstance<py::array>(h) &&
+                        py::isinstance(h, py::module_::import("numbers").attr("Real")));
 }
-
-std::string type_name(const py::handle& h) { return py::str(py::type::of(h).attr("__name__")).cast<std::string>(); }
 
 bool is_sequence(const py::handle& h) { return py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h); }
 
@@ -43,7 +40,7 @@ bool is_sequence(const py::handle& h) { return py::isinstance<py::list>(h) || py
     got = "a " + py::str(a.dtype()).cast<std::string>() + " array of shape " + array_shape(a) +
           (a.dtype().kind() == 'f' && a.itemsize() == 8 ? " in non-native byte order" : "");
   } else {
-    got = "a " + py::str(py::type::of(obj).attr("__name__")).cast<std::string>();
+    got = "a " + type_name(obj);
   }
   throw py::type_error(name + ": expected " + expected + ", got " + got + "; convert with np.asarray(" + name +
                        ", dtype=np.float64)");
@@ -131,6 +128,8 @@ py::array_t<double> matrix_to_numpy(const Eigen::MatrixXd& m) {
   }
   return out;
 }
+
+std::string type_name(const py::handle& obj) { return py::str(py::type::of(obj).attr("__name__")).cast<std::string>(); }
 
 std::string text_arg(const py::handle& obj, const std::string& name) {
   if (!PyUnicode_Check(obj.ptr())) throw py::type_error(name + ": expected a str, got a " + type_name(obj));

@@ -40,6 +40,9 @@ py::array_t<double> vector_to_numpy(const Eigen::VectorXd& v);
 /// \brief A new float64 numpy array (a copy) of a matrix, same shape.
 py::array_t<double> matrix_to_numpy(const Eigen::MatrixXd& m);
 
+/// \brief The name of `obj`'s type, for error messages ("got a list").
+std::string type_name(const py::handle& obj);
+
 /**
  * \brief A Python str as UTF-8 text.
  * \throws py::type_error naming `name` for anything but a str; py::value_error

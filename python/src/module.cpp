@@ -59,8 +59,7 @@ EstimatorParams params_arg(const py::handle& base) {
     apply_settings(p, py::reinterpret_borrow<py::dict>(base));
     return p;
   }
-  throw py::type_error("settings: expected an ofv.EstimatorSettings or a dict, got a " +
-                       py::str(py::type::of(base).attr("__name__")).cast<std::string>());
+  throw py::type_error("settings: expected an ofv.EstimatorSettings or a dict, got a " + type_name(base));
 }
 
 py::dict settings_dict(const EstimatorParams& p) { return typed_values(estimator_settings_table(), p); }

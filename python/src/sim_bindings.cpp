@@ -41,8 +41,7 @@ namespace {
 sim::Scenario scenario_arg(const py::handle& obj) {
   if (py::isinstance<sim::Scenario>(obj)) return obj.cast<sim::Scenario>();
   if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) return sim::load_scenario(path_arg(obj, "scenario"));
-  throw py::type_error("scenario: expected a Scenario, a built-in scenario's name or a scenario file, got a " +
-                       py::str(py::type::of(obj).attr("__name__")).cast<std::string>());
+  throw py::type_error("scenario: expected a Scenario, a built-in scenario's name or a scenario file, got a " + type_name(obj));
 }
 
 py::array_t<double> pose_matrix(const Eigen::Isometry3d& wMc) { return matrix_to_numpy(Eigen::MatrixXd(wMc.matrix())); }
@@ -143,8 +142,9 @@ Episode simulate(const py::object& scenario_obj, const py::object& out, bool pic
     dir = path_arg(out, "out");
   }
   const bool has_callback = !callback.is_none();
-  if (has_callback && !PyCallable_Check(callback.ptr())) throw py::type_error("callback: expected a callable, got a " +
-                                                                              py::str(py::type::of(callback).attr("__name__")).cast<std::string>());
+  if (has_callback && !PyCallable_Check(callback.ptr())) {
+    throw py::type_error("callback: expected a callable, got a " + type_name(callback));
+  }
   // Ctrl-C reaches Python only in the main thread: there the episode looks
   // for it every 0.2 s of wall time (one GIL acquisition).
   const auto threading = py::module_::import("threading");
