@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -152,7 +153,7 @@ struct Voxels {
     constexpr float kSameColour = 25.0f;  // RGB distance, of 441 at most
     const std::size_t n = features.size();
     std::vector<int> survivor(n);  // the voxel each one becomes
-    for (std::size_t i = 0; i < n; ++i) survivor[i] = static_cast<int>(i);
+    std::iota(survivor.begin(), survivor.end(), 0);
     std::vector<char> paired(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
       for (int axis = 0; axis < 3 && !paired[i]; ++axis) {
@@ -174,10 +175,7 @@ struct Voxels {
     std::vector<int> index(n, -1);
     int kept = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (survivor[i] != static_cast<int>(i)) continue;
-      index[i] = kept;
-      features[static_cast<std::size_t>(kept)] = features[i];
-      ++kept;
+      if (survivor[i] == static_cast<int>(i)) index[i] = kept++;
     }
     owners.clear();
     for (std::size_t i = 0; i < n; ++i) {
@@ -185,12 +183,13 @@ struct Voxels {
       map.find_or_insert(cell_key(cells[i])) = to;
       owners.emplace_back(cells[i], to);
     }
-    std::vector<Eigen::Vector3i> kept_cells(static_cast<std::size_t>(kept));
-    for (std::size_t i = 0; i < n; ++i) {
-      if (index[i] >= 0) kept_cells[static_cast<std::size_t>(index[i])] = cells[i];
+    for (std::size_t i = 0; i < n; ++i) {  // in place: index[i] <= i
+      if (index[i] < 0) continue;
+      features[static_cast<std::size_t>(index[i])] = features[i];
+      cells[static_cast<std::size_t>(index[i])] = cells[i];
     }
     features.resize(static_cast<std::size_t>(kept));
-    cells.swap(kept_cells);
+    cells.resize(static_cast<std::size_t>(kept));
   }
 
   /// True when more than `count` voxels (voxel i among them) lie within
