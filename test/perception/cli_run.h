@@ -40,14 +40,6 @@ inline CommandRun shell(const std::string& command) {
   return r;
 }
 
-/// The text of a file ("" if it cannot be read).
-inline std::string file_text(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 /// Runs `ofv ARGS` (OFV_BINARY) through the shell.
 inline CommandRun run(const std::string& args) {
   const std::filesystem::path err =

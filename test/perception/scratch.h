@@ -10,6 +10,8 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -39,3 +41,15 @@ inline const std::string& scratch_dir() {
 }
 
 }  // namespace ofv::test
+
+namespace ofv {
+
+/// The contents of a file, byte for byte ("" if it cannot be read).
+inline std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace ofv

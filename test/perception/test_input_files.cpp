@@ -26,13 +26,6 @@ namespace fs = std::filesystem;
 namespace ofv {
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 void spit(const fs::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
 }
@@ -67,7 +60,7 @@ TEST(InputFiles, BrokenPcdFramesAreExitTwoNamingTheFile) {
     }
   }
   const fs::path frame = dir / "000001.pcd";
-  const std::string good = slurp(frame);
+  const std::string good = file_text(frame);
   ASSERT_EQ(run("perceive " + dir.string()).code, 0);
   const std::size_t data = good.find("DATA binary\n") + 12;
   const std::string header = good.substr(0, data);
@@ -131,7 +124,7 @@ TEST(InputFiles, BrokenTumImagesAndPosesAreExitTwoNamingTheFile) {
   ASSERT_EQ(run("perceive " + dir.string()).code, 0);
   const fs::path depth = dir / "depth" / "0.033333.png";
   const fs::path rgb = dir / "rgb" / "0.033333.png";
-  const std::string good_depth = slurp(depth), good_rgb = slurp(rgb);
+  const std::string good_depth = file_text(depth), good_rgb = file_text(rgb);
   std::string corrupt = good_depth;
   for (std::size_t i = 60; i + 20 < corrupt.size(); i += 7) {
     corrupt[i] = static_cast<char>(corrupt[i] ^ 0x55);
@@ -148,7 +141,7 @@ TEST(InputFiles, BrokenTumImagesAndPosesAreExitTwoNamingTheFile) {
       {"corrupt depth", depth, corrupt, {depth.string(), "corrupt"}},
       {"text depth", depth, "not a png\n", {depth.string()}},
       {"empty depth", depth, "", {depth.string()}},
-      {"16-bit RGB depth", depth, slurp(rgb16), {depth.string(), "16-bit RGB"}},
+      {"16-bit RGB depth", depth, file_text(rgb16), {depth.string(), "16-bit RGB"}},
       {"8-bit RGB depth", depth, good_rgb, {depth.string(), "8-bit RGB"}},
       {"30000 x 30000 depth", depth, with_png_size(good_depth, 30000, 30000), {depth.string(), "30000x30000"}},
       {"corrupt colour", rgb, corrupt, {rgb.string()}},
@@ -161,7 +154,7 @@ TEST(InputFiles, BrokenTumImagesAndPosesAreExitTwoNamingTheFile) {
     spit(rgb, good_rgb);
   }
   // A depth image without a ground-truth pose near its time.
-  const std::string poses = slurp(dir / "groundtruth.txt");
+  const std::string poses = file_text(dir / "groundtruth.txt");
   spit(dir / "groundtruth.txt", poses.substr(0, poses.rfind('\n', poses.size() - 2) + 1));
   expect_bad_input("perceive " + dir.string(), {"groundtruth.txt", "0.033333"}, "missing pose");
   fs::remove(dir / "groundtruth.txt");
@@ -176,7 +169,7 @@ TEST(InputFiles, OniWithAnyHeaderByteChangedIsRefusedOrPlays) {
       writer.write(f);
     }
   }
-  const std::string good = slurp(good_path);
+  const std::string good = file_text(good_path);
   ASSERT_NO_THROW(check_oni_file(good_path.string()));
   // Every byte but the frames' pixels is flipped (XOR 0xFF); the file header's
   // and the record headers' bytes are also incremented (sizes and ids off by one).
@@ -224,7 +217,7 @@ TEST(InputFiles, OniWithAnyHeaderByteChangedIsRefusedOrPlays) {
   }
   EXPECT_GT(refused, 0);
   // Fewer poses than frames: no frame silently takes the last pose.
-  const std::string poses = slurp(good_path.string() + ".poses.txt");
+  const std::string poses = file_text(good_path.string() + ".poses.txt");
   spit(good_path.string() + ".poses.txt", poses.substr(0, poses.rfind('\n', poses.size() - 2) + 1));
   expect_bad_input("perceive " + good_path.string(), {good_path.string() + ".poses.txt", "1 poses for 2 frames"},
                    "missing pose");

@@ -349,13 +349,6 @@ TEST(OniCodecs, JpegDecodesToTheNodesModeOnly) {
 
 // --- .oni files with compressed nodes ---------------------------------------
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 template <typename T>
 T get(const std::string& s, std::size_t at) {
   T v;
@@ -457,7 +450,7 @@ TEST(OniCodecs, CompressedDepthNodesPassTheCheckAndPlayInOpenNi2) {
   for (const std::uint32_t codec : {oni::kCodec16zTables, oni::kCodec16z}) {
     const std::string name = oni::codec_name(codec);
     std::vector<std::size_t> at;
-    const std::string path = spit("ofv_" + name + ".oni", recode(slurp(plain), 1, codec, [&](int, const Bytes& p) {
+    const std::string path = spit("ofv_" + name + ".oni", recode(file_text(plain), 1, codec, [&](int, const Bytes& p) {
       return codec == oni::kCodec16z ? encode_16z(depth_of(p)) : encode_16z_tables(depth_of(p));
     }, at));
     ASSERT_EQ(refusal(path), "") << name;
@@ -469,7 +462,7 @@ TEST(OniCodecs, CompressedDepthNodesPassTheCheckAndPlayInOpenNi2) {
 
     // The second frame one pixel short: refused at its payload, as a decoding that falls short.
     std::vector<std::size_t> damaged_at;
-    const std::string short_path = spit("ofv_" + name + "_short.oni", recode(slurp(plain), 1, codec, [&](int k, const Bytes& p) {
+    const std::string short_path = spit("ofv_" + name + "_short.oni", recode(file_text(plain), 1, codec, [&](int k, const Bytes& p) {
       std::vector<std::uint16_t> d = depth_of(p);
       if (k == 1) d.pop_back();
       return codec == oni::kCodec16z ? encode_16z(d) : encode_16z_tables(d);
@@ -482,7 +475,7 @@ TEST(OniCodecs, CompressedDepthNodesPassTheCheckAndPlayInOpenNi2) {
   }
   // A 16zT index past its table (OpenNI2 would read outside the table): the third frame's first index.
   std::vector<std::size_t> at;
-  std::string bytes = recode(slurp(plain), 1, oni::kCodec16zTables,
+  std::string bytes = recode(file_text(plain), 1, oni::kCodec16zTables,
                              [&](int, const Bytes& p) { return encode_16z_tables(depth_of(p)); }, at);
   const std::size_t first_index = at[2] + 2 + 2 * get<std::uint16_t>(bytes, at[2]);
   set(bytes, first_index, std::uint16_t{0xFFFF});
@@ -500,7 +493,7 @@ TEST(OniCodecs, CompressedColourNodesPassTheCheckAndPlayInOpenNi2) {
   const int w = expected[0].intrinsics.width, h = expected[0].intrinsics.height;
   // Im8z: lossless.
   std::vector<std::size_t> at;
-  const std::string z8 = spit("ofv_8z.oni", recode(slurp(plain), 2, oni::kCodec8z, [](int, const Bytes& p) { return encode_8z(p); }, at));
+  const std::string z8 = spit("ofv_8z.oni", recode(file_text(plain), 2, oni::kCodec8z, [](int, const Bytes& p) { return encode_8z(p); }, at));
   ASSERT_EQ(refusal(z8), "");
   std::vector<RgbdFrame> frames = played(z8);
   ASSERT_EQ(frames.size(), expected.size());
@@ -516,7 +509,7 @@ TEST(OniCodecs, CompressedColourNodesPassTheCheckAndPlayInOpenNi2) {
     return out;
   };
   at.clear();
-  const std::string jpg = spit("ofv_jpeg.oni", recode(slurp(plain), 2, oni::kCodecJpeg, jpeg, at));
+  const std::string jpg = spit("ofv_jpeg.oni", recode(file_text(plain), 2, oni::kCodecJpeg, jpeg, at));
   ASSERT_EQ(refusal(jpg), "");
   frames = played(jpg);
   ASSERT_EQ(frames.size(), expected.size());
@@ -528,7 +521,7 @@ TEST(OniCodecs, CompressedColourNodesPassTheCheckAndPlayInOpenNi2) {
   // A JPEG of the wrong size, and one cut short: refused at the payload.
   for (const bool cut : {false, true}) {
     at.clear();
-    const std::string path = spit("ofv_jpeg_bad.oni", recode(slurp(plain), 2, oni::kCodecJpeg, [&](int k, const Bytes& p) {
+    const std::string path = spit("ofv_jpeg_bad.oni", recode(file_text(plain), 2, oni::kCodecJpeg, [&](int k, const Bytes& p) {
       Bytes out = jpeg(k, p);
       if (k == 2 && cut) out.resize(out.size() - 100);
       if (k == 2 && !cut) cv::imencode(".jpg", cv::Mat(h, w / 2, CV_8UC3, cv::Scalar(1, 2, 3)), out);
