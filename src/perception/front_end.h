@@ -99,6 +99,7 @@ struct Perception::Impl {
   // foreign voxels of a mixed boundary supervoxel (a hand's, the table's)
   // never become object and cannot pull their neighbours in next frame.
   std::vector<char> voxel_matched;
+  std::vector<char> voxel_revealed;  // revealed object surface (grow_revealed()), remembered
   // object_motion(): the frame's object voxels (hashed), normals and
   // chromaticities, and the voxels on the object's own outline with the
   // outline's outward normal, of this frame and of the previous one.
@@ -130,6 +131,7 @@ struct Perception::Impl {
   detail::PointGrid seen_grid;                 // the frame's object voxels (remember())
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
   bool incomplete = false;  // the first frame showed an occluder cutting the object (behind_occluders())
+  RgbdFrame previous;  // the previous frame's depth, pose and intrinsics (no colour): revealed()
   std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
 
@@ -176,6 +178,8 @@ struct Perception::Impl {
   /// object_memory.cpp: a later frame's object supervoxels, those near the
   /// remembered object voxels; sets voxel_matched.
   std::vector<char> track(const PerceptionResult& r);
+  /// Grows `object` over surface the previous frame could not see (TrackingSettings::grow_revealed).
+  void grow_revealed(const PerceptionResult& r, const std::vector<int>& near, std::vector<char>& object);
   /// pipeline.cpp: r.status and r.message from the object found; the first
   /// frame found also sets the state's start (initialised, initial_voxels).
   void set_status(PerceptionResult& r, const std::vector<char>& object, std::string why);

@@ -82,6 +82,10 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
     centroid = r.centroid;
   }
   r.timings.classify = ms_since(stage);
+  // What this frame could see, for the next one's revealed surface.
+  previous.depth.assign(frame.depth.begin(), frame.depth.end());
+  previous.intrinsics = frame.intrinsics;
+  previous.wMc = frame.wMc;
   r.timings.total = ms_since(start);
   return r;
 }

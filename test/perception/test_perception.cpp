@@ -359,6 +359,52 @@ TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
   EXPECT_GE(score.precision, 0.95);
 }
 
+TEST(Perception, SurfaceItsOwnFrontHidJoinsTheObjectWhenRevealed) {
+  // The object has a lower panel standing 8 cm behind its front (a folded
+  // sheet's far half), which the front hides from the first camera. As the
+  // camera rises, 2.65 cm a frame, the panel comes into view over the front
+  // faster than max_motion: the surface the object itself hid is the
+  // object's (grow_revealed); without it, only what comes within max_motion
+  // of the remembered object joins, and the panel stays an occluder.
+  const Eigen::Vector3d rear_centre(0.0, 0.08, 0.045);
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(test::make_box(rear_centre, {0.16, 0.015, 0.09}, {40, 60, 200}, kObject));
+  perception::PerceptionSettings on;
+  on.tracking.grow_revealed = true;
+  perception::PerceptionSettings off = on;
+  off.tracking.grow_revealed = false;
+  perception::Perception grow{on};
+  perception::Perception stay{off};
+  const auto rear_recall = [&](const perception::PerceptionResult& r) {
+    int seen = 0;
+    int object = 0;
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      if (r.voxels[i].y() < 0.06f || r.voxels[i].z() < 0.005f) continue;  // the panel, not the case or the table
+      ++seen;
+      object += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
+    }
+    return std::make_pair(seen, seen > 0 ? static_cast<double>(object) / seen : 0.0);
+  };
+  for (int k = 0; k <= 20; ++k) {
+    const Eigen::Isometry3d wMc = test::look_at(kCaseCentre + Eigen::Vector3d(0.0, -0.45, 0.22 + 0.0265 * k), kCaseCentre);
+    Frame f = render(scene, wMc, 320);
+    test::add_depth_noise(f.frame, 5u + static_cast<unsigned>(k));
+    const perception::PerceptionResult rg = grow.process(f.frame);
+    const perception::PerceptionResult rs = stay.process(f.frame);
+    ASSERT_NE(rg.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rg.message;
+    ASSERT_NE(rs.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rs.message;
+    if (k == 0) {
+      EXPECT_EQ(rear_recall(rg).first, 0) << "the first camera sees the panel";
+    }
+    if (k == 20) {
+      ASSERT_GE(rear_recall(rg).first, 100) << "the last camera does not see the panel";
+      EXPECT_GE(rear_recall(rg).second, 0.95);
+      EXPECT_LE(rear_recall(rs).second, 0.5);
+      EXPECT_EQ(rg.counts.object_voxels > rs.counts.object_voxels, true);
+    }
+  }
+}
+
 /// Largest distance of the problem's hidden vertices (its last
 /// counts.hidden_vertices columns) from the case, the box of `centre` [m].
 double hidden_vertices_off_case(const perception::PerceptionResult& r, const Eigen::Vector3d& centre) {
