@@ -178,16 +178,18 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
                              std::to_string(options_.timeout_ms) + " ms: " + last_error());
   }
   ++s.read;
-  const openni::VideoMode mode = depth.getVideoMode();
-  const openni::PixelFormat format = mode.getPixelFormat();
-  double scale = 0.0;
-  if (format == openni::PIXEL_FORMAT_DEPTH_1_MM) {
-    scale = 1e-3;
-  } else if (format == openni::PIXEL_FORMAT_DEPTH_100_UM) {
-    scale = 1e-4;
-  } else {
-    throw std::runtime_error(uri_ + ": unsupported depth pixel format " +
-                             std::to_string(static_cast<int>(format)));
+  const auto depth_scale = [](openni::PixelFormat format) {
+    return format == openni::PIXEL_FORMAT_DEPTH_1_MM ? 1e-3 : format == openni::PIXEL_FORMAT_DEPTH_100_UM ? 1e-4 : 0.0;
+  };
+  const double scale = depth_scale(depth.getVideoMode().getPixelFormat());
+  if (scale == 0.0) {
+    const std::string why = uri_ + ": unsupported depth pixel format " +
+                            std::to_string(static_cast<int>(depth.getVideoMode().getPixelFormat()));
+    // A stream set to depth that hands over another format has had a glitch
+    // (OpenNI2's DummyDevice once gave its depth stream a colour frame on a
+    // loaded machine): that frame is bad, not the device.
+    if (depth_scale(s.depth.getVideoMode().getPixelFormat()) != 0.0) throw BadFrame(why);
+    throw std::runtime_error(why);
   }
   const int w = depth.getWidth();
   const int h = depth.getHeight();

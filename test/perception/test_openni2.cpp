@@ -10,6 +10,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <optional>
 
 namespace fs = std::filesystem;
 
@@ -143,7 +145,16 @@ TEST(OpenNi2, DummyDeviceGivesDepthAndColour) {
   options.intrinsics = test::vga(320);
   OpenNi2Source source("Dummy", options);
   EXPECT_FALSE(source.is_file());
-  const auto f = source.next();
+  // A frame the driver garbles is a BadFrame, which drivers skip (seen once
+  // on a loaded machine: a colour frame on the depth stream); so here.
+  std::optional<RgbdFrame> f;
+  for (int attempt = 0; attempt < 3 && !f; ++attempt) {
+    try {
+      f = source.next();
+    } catch (const BadFrame& e) {
+      std::cerr << "skipped a bad frame: " << e.what() << '\n';
+    }
+  }
   ASSERT_TRUE(f);
   EXPECT_EQ(f->intrinsics.width, 320);
   EXPECT_EQ(f->intrinsics.height, 240);
