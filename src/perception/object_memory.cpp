@@ -60,19 +60,17 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   const std::size_t n = r.supervoxels.size();
   const auto max_chroma = static_cast<float>(t.max_chroma_distance);
   const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
-  const auto same_chroma = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-    return max_chroma <= 0.0f || (a - b).norm() <= max_chroma;
-  };
-  // A voxel the previous frame could not see: in its image, behind a
-  // surface nearer its camera by more than max_motion. Hidden by the object
-  // itself (the surface in front was a remembered voxel of its colour: its
-  // own fold) it is the object's; hidden by something else, it is when it
-  // touches the object (below).
+  // A voxel the previous frame could not see (in its image, behind a
+  // surface nearer its camera by more than max_motion) is the object's when
+  // that surface was the object: a remembered voxel of the voxel's
+  // chromaticity (its own fold hid it). Voxel by voxel, so that a hand
+  // never joins through a supervoxel that mixes it with the object.
   const Eigen::Isometry3d cMw = previous.wMc.inverse();
   const CameraIntrinsics& k = previous.intrinsics;
-  std::vector<int> hidden_before(n, 0);
-  std::vector<int> behind_object(n, 0);
-  std::vector<char> voxel_hidden(r.voxels.size(), 0);
+  std::vector<int> hidden_before(n, 0);  // every hidden voxel
+  std::vector<int> seen_before(n, 0);    // voxels the previous frame showed where they are
+  std::vector<int> revealed(n, 0);       // those that are the object's
+  std::vector<char> voxel_revealed_here(r.voxels.size(), 0);
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     if (object[owner] || plane_voxel(r.voxels[i], sv.colours[i])) continue;
@@ -83,62 +81,65 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
     const int v = static_cast<int>(std::lround(px->y()));
     if (u < 0 || v < 0 || u >= k.width || v >= k.height) continue;
     const float d = previous.depth[previous.index(u, v)];
-    if (!(std::isfinite(d) && d > 0.0f && static_cast<double>(d) < z - t.max_motion)) continue;
-    voxel_hidden[i] = 1;
+    if (!(std::isfinite(d) && d > 0.0f)) continue;
+    if (std::abs(static_cast<double>(d) - z) <= t.max_motion) ++seen_before[owner];
+    if (!(static_cast<double>(d) < z - t.max_motion)) continue;
     ++hidden_before[owner];
     const Eigen::Vector3f hider =
         (previous.wMc * Eigen::Vector3d((u - k.cx) * d / k.fx, (v - k.cy) * d / k.fy, d)).cast<float>();
     const Eigen::Vector3f c = chroma(sv.colours[i]);
-    if (grid.any_within(hider, res, [&](int j) { return same_chroma(memory_chroma[static_cast<std::size_t>(j)], c); })) {
-      voxel_hidden[i] = 2;
-      ++behind_object[owner];
+    if (grid.any_within(hider, res, [&](int j) {
+          return max_chroma <= 0.0f || (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
+        })) {
+      voxel_revealed_here[i] = 1;
+      ++revealed[owner];
     }
   }
-  if (std::all_of(hidden_before.begin(), hidden_before.end(), [](int h) { return h == 0; })) return;
-  const auto enough = [&](std::size_t i, int count) {
-    return static_cast<double>(count + near[i]) >= t.min_near_fraction * static_cast<double>(r.supervoxels[i].voxel_count);
-  };
-  std::vector<char> reached(n, 0);
-  std::vector<int> open;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (object[i]) {
-      open.push_back(static_cast<int>(i));
-    } else if (behind_object[i] > 0 && !on_plane(r.supervoxels[i])) {
-      reached[i] = 1;
-      if (enough(i, behind_object[i])) {
-        object[i] = 1;
-        open.push_back(static_cast<int>(i));
-      }
-    }
-  }
-  // Over the adjacency from the object, between neighbours of one
-  // chromaticity. A neighbour joins when its revealed voxels and those near
-  // the memory make min_near_fraction of it; one that does not yet
-  // (revealed a strip at a time) keeps its revealed voxels in the memory,
-  // so that it joins once enough of it is.
+  // A supervoxel joins when its revealed voxels and those near the memory
+  // make min_near_fraction of it; the revealed voxels of one that does not
+  // yet (revealed a strip at a time) are remembered, so that it joins once
+  // enough of it is. One that continues a surface of its colour seen before
+  // and not the object's (a distractor whose side the object hid) could be
+  // either's: it stays out.
   std::vector<std::vector<int>> neighbours(n);
   for (const auto& [a, b] : r.adjacency) {
     neighbours[static_cast<std::size_t>(a)].push_back(b);
     neighbours[static_cast<std::size_t>(b)].push_back(a);
   }
+  // Ambiguous: surface joined, through neighbours of one chromaticity that
+  // are not the object's, to a surface of that colour the previous frame
+  // showed (most of its voxels) that is not the object's (none near the memory).
+  const auto alike = [&](std::size_t x, std::size_t y) {
+    return max_chroma <= 0.0f ||
+           (chroma(r.supervoxels[x].colour) - chroma(r.supervoxels[y].colour)).norm() <= max_chroma;
+  };
+  std::vector<char> ambiguous(n, 0);
+  std::vector<std::size_t> open;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (!object[j] && 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0 && !on_plane(r.supervoxels[j])) {
+      open.push_back(j);
+    }
+  }
   while (!open.empty()) {
-    const auto a = static_cast<std::size_t>(open.back());
+    const std::size_t x = open.back();
     open.pop_back();
-    const Eigen::Vector3f ca = chroma(r.supervoxels[a].colour);
-    for (const int b : neighbours[a]) {
-      const auto j = static_cast<std::size_t>(b);
-      const SupervoxelInfo& s = r.supervoxels[j];
-      if (object[j] || hidden_before[j] == 0 || on_plane(s) || !same_chroma(chroma(s.colour), ca)) continue;
-      reached[j] = 1;
-      if (enough(j, hidden_before[j])) {
-        object[j] = 1;
-        open.push_back(b);
+    for (const int other : neighbours[x]) {
+      const auto y = static_cast<std::size_t>(other);
+      if (!ambiguous[y] && !object[y] && !on_plane(r.supervoxels[y]) && alike(x, y)) {
+        ambiguous[y] = 1;
+        open.push_back(y);
       }
     }
   }
+  std::vector<char> reached(n, 0);
+  for (std::size_t j = 0; j < n; ++j) {
+    if (revealed[j] == 0 || on_plane(r.supervoxels[j]) || ambiguous[j]) continue;
+    reached[j] = 1;
+    object[j] = static_cast<double>(revealed[j] + near[j]) >=
+                t.min_near_fraction * static_cast<double>(r.supervoxels[j].voxel_count);
+  }
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
-    if (reached[owner] && (voxel_hidden[i] == 2 || (voxel_hidden[i] == 1 && object[owner]))) voxel_revealed[i] = 1;
+    voxel_revealed[i] = voxel_revealed_here[i] && reached[static_cast<std::size_t>(r.voxel_owner[i])] ? 1 : 0;
   }
 }
 

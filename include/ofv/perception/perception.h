@@ -107,21 +107,23 @@ struct TrackingSettings {
   /// little of the object is dropped. false: hidden parts stay where they
   /// were last seen.
   bool follow_motion = true;
-  /// Surface revealed since the previous frame joins the object, even
-  /// where no remembered voxel lies within max_motion: a voxel the previous
-  /// frame could not see (in its image, behind a surface nearer its camera
-  /// by more than max_motion) is the object's when that surface was the
-  /// object (a remembered voxel of the voxel's chromaticity: its own fold
-  /// hid it), or when its supervoxel is adjacent (R_adj) to the object and
-  /// of its neighbour's chromaticity (an occluder that moved away had hid
-  /// it). A supervoxel joins when such voxels and those near the memory
-  /// make min_near_fraction of it (never one on the support plane); the
-  /// revealed voxels of one that does not yet are remembered, so that it
-  /// joins once enough of it is. What comes into view from outside the
-  /// previous image, or through space the previous frame showed empty (a
-  /// hand moving in), does not qualify. false: only what lies within
-  /// max_motion of the remembered object (the paper's assumption 2).
-  bool grow_revealed = true;
+  /// Surface the object itself hid joins the object when it comes into
+  /// view, even where no remembered voxel lies within max_motion (a camera
+  /// moving round a folded cloth sees its far half appear from behind its
+  /// near half): a voxel the previous frame could not see (in its image,
+  /// behind a surface nearer its camera by more than max_motion) whose
+  /// hiding surface was the object (a remembered voxel of the voxel's
+  /// chromaticity) counts as the object's. A supervoxel joins when those
+  /// and the near voxels make min_near_fraction of it, never one on the
+  /// support plane nor one touching a surface of its colour seen before and
+  /// not the object's (a distractor whose side the object hid could be
+  /// either's); the counted voxels of one that does not yet are remembered,
+  /// so that it joins once enough of it is. Off by default: a distractor of
+  /// the object's colour standing behind it, seen beside it first, can
+  /// still join once more of it comes into view (docs/perception.md).
+  /// false: only what lies within max_motion of the remembered object (the
+  /// paper's assumption 2).
+  bool grow_revealed = false;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
   /// this distance, normal within 60 degrees) are never object: the table
