@@ -21,6 +21,17 @@
 
 namespace ofv {
 
+/// \brief Whether the loop knows the camera pose of a frame (Observation::pose).
+enum class PoseStatus {
+  Known,    ///< the frame's own pose (robot, recording, simulator) or one a pose source estimated
+  /// The pose source could not tell it (RGB-D odometry failed or found an
+  /// implausible motion): `wMc` is its last good pose. The loop commands
+  /// zero velocity for the frame (ofv::servo::SafetyAction::PoseUnknown).
+  Unknown,
+};
+/// \brief The status's word in files and on the terminal: known, unknown.
+[[nodiscard]] const char* to_string(PoseStatus status);
+
 /// \brief One frame's observation, world frame [m].
 struct Observation {
   /// The estimator's input: the object's supervoxels and the occluders seen
@@ -35,8 +46,13 @@ struct Observation {
   /// in the frame times a voxel's face; std::nullopt when unknown (then the
   /// loop never retreats, RetreatSettings::drop).
   std::optional<double> shown_area;
-  /// Pose of the camera that took the frame (world ← camera).
+  /// Pose of the camera that took the frame (world ← camera): the frame's
+  /// own, or a pose source's (ofv::PoseSource, e.g. RGB-D odometry).
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+  /// Whether `wMc` is known for this frame: a pose source that could not
+  /// tell it leaves its last good pose in `wMc` and says Unknown here; the
+  /// loop then stops, as for a stale frame. The driver sets it.
+  PoseStatus pose = PoseStatus::Known;
   /// How old the frame is when its command is sent [s] (older than the
   /// stale timeout: stop). The driver sets it.
   double age = 0.0;

@@ -144,6 +144,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
   BadFrameBudget bad_frames(options.max_bad_frames_in_row, options.max_bad_frames_per_minute);
   try {
     std::optional<double> first_stamp, last_stamp;
+    std::optional<double> object_depth;  // for the pose source: the object's nearest depth in the last frame
     while (options.stop == nullptr || *options.stop == 0) {
       const auto asked = Clock::now();
       std::optional<RgbdFrame> frame;
@@ -178,9 +179,26 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       if (watchdog.stops() != watchdog_stops) loop.robot_stopped();
       watchdog_stops = watchdog.stops();
       Observation observation;
+      std::optional<FramePose> pose;
       out.bad_frame = unusable;
       try {
-        if (unusable.empty()) observation = observer.observe(*frame);
+        if (unusable.empty()) {
+          if (options.pose_source) {
+            // The observer sees the frame with the source's pose; the frame
+            // keeps its own (the robot's, the recording's) for on_frame.
+            pose = options.pose_source(*frame, object_depth);
+            const Eigen::Isometry3d own = frame->wMc;
+            frame->wMc = pose->wMc;
+            struct Restore {
+              RgbdFrame& f;
+              Eigen::Isometry3d wMc;
+              ~Restore() { f.wMc = wMc; }
+            } restore{*frame, own};
+            observation = observer.observe(*frame);
+          } else {
+            observation = observer.observe(*frame);
+          }
+        }
       } catch (const std::invalid_argument& e) {
         out.bad_frame = first_line(e.what());
       }
@@ -203,13 +221,17 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
         continue;
       }
       bad_frames.good();
-      observation.wMc = frame->wMc;
+      observation.wMc = pose ? pose->wMc : frame->wMc;
+      observation.pose = !pose || pose->ok ? PoseStatus::Known : PoseStatus::Unknown;
+      out.pose = pose ? &*pose : nullptr;
+      object_depth = observation.problem ? nearest_depth(observation.problem->positions, observation.wMc) : std::nullopt;
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       observation.age = out.frame_age = options.wall_clock_age ? out.perception_s : gap;
       out.observation = &observation;
       const LoopStep step = loop.step(observation, dt);
       out.step = &step;
       summary.lost += step.status == StepStatus::ObjectLost ? 1 : 0;
+      summary.pose_unknown += observation.pose == PoseStatus::Unknown ? 1 : 0;
       // A period that is not finite and positive (a timestamp going backwards
       // or NaN) came with a stop: the robot gets no period it cannot integrate.
       out.dt = std::isfinite(dt) && dt > 0.0 ? dt : 0.0;

@@ -21,13 +21,14 @@ const char* to_string(SafetyAction action) {
     case SafetyAction::ObjectLost: return "object lost";
     case SafetyAction::StaleFrame: return "stale frame";
     case SafetyAction::BadFrame: return "bad frame";
+    case SafetyAction::PoseUnknown: return "pose unknown";
   }
   return "?";
 }
 
 bool stops(SafetyAction action) {
   return action == SafetyAction::InvalidCommand || action == SafetyAction::ObjectLost ||
-         action == SafetyAction::StaleFrame || action == SafetyAction::BadFrame;
+         action == SafetyAction::StaleFrame || action == SafetyAction::BadFrame || action == SafetyAction::PoseUnknown;
 }
 
 void validate(const SafetySettings& s) {
@@ -47,7 +48,7 @@ void validate(const SafetySettings& s) {
 SafetyFilter::SafetyFilter(const SafetySettings& settings) : settings_(settings) { validate(settings_); }
 
 vpColVector SafetyFilter::filter(const vpColVector& v_in, const vpHomogeneousMatrix& wMc, double dt,
-                                 bool object_tracked, double frame_age) {
+                                 bool object_tracked, double frame_age, bool pose_known) {
   // Conditions that stop the robot at once (the drive's own deceleration applies).
   auto stop = [this](SafetyAction why) {
     action_ = why;
@@ -57,6 +58,9 @@ vpColVector SafetyFilter::filter(const vpColVector& v_in, const vpHomogeneousMat
   bool finite = v_in.size() == 6 && std::isfinite(dt) && dt > 0.0;
   for (unsigned i = 0; finite && i < 6; ++i) finite = std::isfinite(v_in[i]);
   if (!finite) return stop(SafetyAction::InvalidCommand);
+  // Before the object: a way back (lost, driving to the best view seen) is
+  // driven from the camera's pose, unknown here.
+  if (!pose_known) return stop(SafetyAction::PoseUnknown);
   if (!object_tracked) return stop(SafetyAction::ObjectLost);
   if (!(frame_age <= settings_.stale_timeout)) return stop(SafetyAction::StaleFrame);
 

@@ -438,7 +438,8 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
     out.command = controller.update(*out.target, *last_centroid, estimator.r_sphere, wMc, dt);
   }
   // Lost, the camera moves only on its way back.
-  out.velocity = safety.filter(out.command, wMc, dt, out.estimate.has_value() || out.target.has_value(), observation.age);
+  out.velocity = safety.filter(out.command, wMc, dt, out.estimate.has_value() || out.target.has_value(), observation.age,
+                               observation.pose == PoseStatus::Known);
   out.safety = safety.last_action();
   out.control_s = seconds_since(start);
   return out;

@@ -64,10 +64,7 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     bad_frames.good();
     f.index = summary.frames;
     object_depth.reset();
-    if (f.result.status != TrackingStatus::Lost && f.result.problem.positions.cols() > 0) {
-      const Eigen::Isometry3d cMw = f.frame.wMc.inverse();
-      object_depth = (cMw * f.result.problem.positions).row(2).minCoeff();
-    }
+    if (f.result.status != TrackingStatus::Lost) object_depth = nearest_depth(f.result.problem.positions, f.frame.wMc);
     front_end_ms.push_back(f.result.timings.total);
     if (f.result.status != TrackingStatus::Lost) {
       f.result.problem.previous_view = previous_view;

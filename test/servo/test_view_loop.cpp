@@ -99,6 +99,39 @@ TEST(ViewLoop, StatusesAndTheSafetyFilterInTheLoop) {
   EXPECT_EQ(still.step(observed(patch(true), wMc, 0.0), dt).velocity.frobeniusNorm(), 0.0);
 }
 
+// A frame whose camera pose the pose source could not tell (RGB-D odometry
+// failed): exactly zero velocity, whatever the frame shows, and the next
+// frame starts again from rest within the acceleration limits.
+TEST(ViewLoop, AFrameOfUnknownPoseStopsAndTheNextStartsFromRest) {
+  const servo::LoopSettings settings;
+  servo::ViewLoop loop(settings);
+  const vpHomogeneousMatrix wMc;
+  const double dt = 1.0 / 30.0;
+  servo::LoopStep s;
+  for (int k = 0; k < 6; ++k) s = loop.step(observed(patch(true), wMc, 0.0), dt);
+  ASSERT_GT(speed(s.velocity), 1.5 * settings.safety.max_linear_accel * dt);  // under way, beyond one step from rest
+  Observation unknown = observed(patch(true), wMc, 0.0);
+  unknown.pose = PoseStatus::Unknown;
+  s = loop.step(unknown, dt);
+  EXPECT_EQ(s.safety, servo::SafetyAction::PoseUnknown);
+  EXPECT_TRUE(stops(s.safety));
+  EXPECT_STREQ(to_string(s.safety), "pose unknown");
+  EXPECT_EQ(s.status, servo::StepStatus::Converged);  // the frame was seen; only its pose is not known
+  for (unsigned i = 0; i < 6; ++i) EXPECT_EQ(s.velocity[i], 0.0) << i;
+  // The next frame, its pose known: from rest, within the acceleration limits.
+  s = loop.step(observed(patch(true), wMc, 0.0), dt);
+  EXPECT_FALSE(stops(s.safety));
+  EXPECT_GT(speed(s.velocity), 0.0);
+  EXPECT_LE(speed(s.velocity), settings.safety.max_linear_accel * dt * (1.0 + 1e-9));
+  EXPECT_LE(std::hypot(s.velocity[3], s.velocity[4], s.velocity[5]), settings.safety.max_angular_accel * dt * (1.0 + 1e-9));
+  // Unknown and lost: the pose is the reason (a way back would be driven from it).
+  unknown = observed(std::nullopt, wMc, 0.0);
+  unknown.pose = PoseStatus::Unknown;
+  s = loop.step(unknown, dt);
+  EXPECT_EQ(s.safety, servo::SafetyAction::PoseUnknown);
+  EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+}
+
 // The first frame whose target is more than 1 cm from t0 (the origin), as an
 // occluder cluster at 30 cm from the camera crosses the line of sight at
 // 0.6 m/s; -1 if none.
@@ -458,6 +491,54 @@ TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
   EXPECT_FALSE(stops(actions[1]));
   EXPECT_EQ(actions[3], servo::SafetyAction::StaleFrame);  // 5 s after the previous frame
   EXPECT_FALSE(stops(actions[4]));
+}
+
+// RobotLoopOptions::pose_source: the observer and the loop get its pose,
+// the frame keeps its own, and a frame whose pose it cannot tell stops the
+// robot (and only that frame). It is told the object's nearest depth in the
+// previous frame, as the pose it gave sees it.
+TEST(RobotLoop, APoseSourceGivesThePoseAndAFrameWithoutOneStopsTheRobot) {
+  Timestamps source({0.0, 1.0 / 30, 2.0 / 30, 3.0 / 30, 4.0 / 30});
+  servo::FreeFlyingCamera robot{vpHomogeneousMatrix()};
+  servo::RobotLoopOptions options;
+  std::vector<std::optional<double>> depths;
+  int calls = 0;
+  options.pose_source = [&](const RgbdFrame& frame, std::optional<double> object_depth) {
+    depths.push_back(object_depth);
+    EXPECT_TRUE(frame.wMc.isApprox(Eigen::Isometry3d::Identity()));  // the frame's own
+    FramePose pose;
+    pose.wMc = Eigen::Translation3d(0.0, 0.0, 0.01 * std::min(calls, 2)) * Eigen::Isometry3d::Identity();
+    pose.ok = calls != 3;
+    pose.status = pose.ok ? "ok" : "failed";
+    ++calls;
+    return pose;
+  };
+  Fixed observer(patch(true));
+  std::vector<servo::SafetyAction> actions;
+  std::vector<double> speeds;
+  const servo::RobotLoopSummary summary =
+      servo::run_on_robot(source, observer, robot, servo::LoopSettings{}, options, [&](const servo::RobotLoopFrame& f) {
+        actions.push_back(f.step->safety);
+        speeds.push_back(speed(f.step->velocity));
+        ASSERT_NE(f.pose, nullptr);
+        EXPECT_EQ(f.pose->status, f.index == 3 ? "failed" : "ok");
+        EXPECT_TRUE(f.frame->wMc.isApprox(Eigen::Isometry3d::Identity()));
+        EXPECT_DOUBLE_EQ(f.observation->wMc.translation().z(), 0.01 * std::min<long>(f.index, 2));
+        EXPECT_EQ(f.observation->pose, f.index == 3 ? PoseStatus::Unknown : PoseStatus::Known);
+      });
+  EXPECT_EQ(summary.frames, 5);
+  EXPECT_EQ(summary.pose_unknown, 1);
+  ASSERT_EQ(actions.size(), 5U);
+  EXPECT_EQ(actions[3], servo::SafetyAction::PoseUnknown);
+  EXPECT_EQ(speeds[3], 0.0);
+  EXPECT_GT(speeds[2], 0.0);
+  EXPECT_FALSE(stops(actions[4]));
+  // The patch is 0.5 m ahead of the world origin: 0.5 - z of the pose used.
+  ASSERT_EQ(depths.size(), 5U);
+  EXPECT_FALSE(depths[0]);
+  ASSERT_TRUE(depths[1] && depths[2]);
+  EXPECT_NEAR(*depths[1], 0.5, 1e-12);
+  EXPECT_NEAR(*depths[2], 0.49, 1e-12);
 }
 
 TEST(RobotLoop, TheStopFlagEndsTheRunAndMaxDurationTheSource) {

@@ -20,6 +20,7 @@
 #include "ofv/frame_source.h"
 #include "ofv/perception/perception.h"
 #include "ofv/perception/scores.h"
+#include "ofv/pose_source.h"
 #include "ofv/rgbd_frame.h"
 
 #include <functional>
@@ -30,27 +31,10 @@
 
 namespace ofv::perception {
 
-/**
- * \brief A frame's camera pose from a pose source other than the frame's
- *        own (perceive()'s `pose_source`, e.g. RGB-D odometry).
- */
-struct FramePose {
-  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< the pose the front end gets [m]
-  /// False when the source could not tell this frame's pose: `wMc` is then
-  /// its last good one, never a jump.
-  bool ok = true;
-  std::string source;  ///< the source's word, for the records (`odometry`)
-  std::string status;  ///< its word for this frame, for the records (`ok`, `failed`, ...)
-  std::vector<std::pair<std::string, double>> diagnostics;  ///< numbers for the records, in order
-};
-
-/**
- * \brief Gives a frame's camera pose before the front end runs. Called once
- *        per frame, in order, with the frame as the source read it and the
- *        object's nearest depth in the previous frame's camera [m] (none
- *        before the object is found or when it was lost).
- */
-using PoseSource = std::function<FramePose(const RgbdFrame& frame, std::optional<double> object_depth)>;
+/// \brief A frame's pose from a pose source (ofv/pose_source.h): perceive()'s `pose_source` gives them.
+using FramePose = ofv::FramePose;
+/// \brief What gives a frame's pose before the front end runs (ofv/pose_source.h).
+using PoseSource = ofv::PoseSource;
 
 /// \brief One frame as perceive() saw it: what the front end found and the view estimated.
 struct PerceivedFrame {

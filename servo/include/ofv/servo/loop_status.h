@@ -31,8 +31,11 @@ enum class SafetyAction {
   ObjectLost,         ///< no object: stop
   StaleFrame,         ///< the frame is older than stale_timeout: stop
   BadFrame,           ///< the frame failed its checks and was skipped: stop
+  /// The frame's camera pose is not known (ofv::Observation::pose: RGB-D
+  /// odometry failed or found an implausible motion): stop, as for a stale frame.
+  PoseUnknown,
 };
-/// \brief The action's words in files ("" for None, "speed limit", "stale frame" ...).
+/// \brief The action's words in files ("" for None, "speed limit", "stale frame", "pose unknown" ...).
 [[nodiscard]] const char* to_string(SafetyAction action);
 /// \brief True for the actions that stop the robot.
 [[nodiscard]] bool stops(SafetyAction action);

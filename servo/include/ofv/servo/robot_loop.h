@@ -9,6 +9,7 @@
 
 #include "ofv/frame_source.h"
 #include "ofv/observation.h"
+#include "ofv/pose_source.h"
 #include "ofv/servo/robot.h"
 #include "ofv/servo/view_loop.h"
 
@@ -26,6 +27,13 @@ struct RobotLoopOptions {
   /// eye-in-hand sensor); otherwise the frame carries its pose (recordings,
   /// the simulated sensor).
   bool pose_from_robot = false;
+  /// When set, the pose the front end and the loop get: called with each
+  /// frame (its pose the robot's with pose_from_robot, else its own) and
+  /// the object's nearest depth in the previous frame (ofv::nearest_depth),
+  /// before the observer; a pose it marks not ok makes the frame's
+  /// Observation::pose Unknown, and the loop stops for it. RGB-D odometry:
+  /// ofv::odometry::odometry_pose_source(). Frames skipped as bad do not reach it.
+  PoseSource pose_source;
   /// A frame's age is the wall-clock time since it arrived (live sources);
   /// otherwise the gap to the previous frame's timestamp (recordings).
   bool wall_clock_age = false;
@@ -57,6 +65,9 @@ struct RobotLoopOptions {
 struct RobotLoopFrame {
   long index = 0;                    ///< frames before this one in the run
   const RgbdFrame* frame = nullptr;  ///< the frame as read (its pose the robot's with pose_from_robot)
+  /// With a pose source: what it said for this frame (the pose the loop got
+  /// is the observation's); nullptr without one, or for a bad frame.
+  const FramePose* pose = nullptr;
   const Observation* observation = nullptr;  ///< what the loop was given (its age set)
   const LoopStep* step = nullptr;  ///< what the loop decided and sent
   std::string bad_frame;  ///< why the frame was skipped (empty: it was not); step->status is then BadFrame
@@ -70,6 +81,7 @@ struct RobotLoopFrame {
 struct RobotLoopSummary {
   long frames = 0;       ///< frames read and answered with a command
   long lost = 0;         ///< frames without the object
+  long pose_unknown = 0;  ///< frames whose pose the pose source could not tell (RobotLoopOptions::pose_source)
   long bad_frames = 0;   ///< frames skipped for failing their checks
   bool stopped = false;  ///< ended by the stop flag
   long watchdog_stops = 0;  ///< zero velocities the watchdog sent between frames
@@ -81,7 +93,8 @@ struct RobotLoopSummary {
  *        velocity (also when an exception leaves it), so the robot is left at rest.
  *
  * A frame older than the stale timeout, a timestamp that does not increase
- * or is not finite, or a lost object gives a zero velocity for that frame;
+ * or is not finite, a lost object or a pose the pose source could not tell
+ * gives a zero velocity for that frame;
  * the robot is never sent a period that is not finite and >= 0 (0 with
  * such a stop), and a non-finite timestamp is not the next frame's time base.
  * \param source   the frames, read until it ends

@@ -36,7 +36,7 @@ void validate(const SafetySettings& settings);
 
 /**
  * \brief Speed, acceleration and workspace limits, and zero velocity when
- *        the object is lost or the frame is stale.
+ *        the object is lost, the frame is stale or its camera pose unknown.
  */
 class SafetyFilter {
  public:
@@ -48,10 +48,12 @@ class SafetyFilter {
    * \param dt period [s].
    * \param object_tracked false when perception lost the object.
    * \param frame_age age of the frame the command comes from [s].
+   * \param pose_known false when the frame's camera pose is not known
+   *        (ofv::Observation::pose): stop, SafetyAction::PoseUnknown.
    * \return the twist to send.
    */
   [[nodiscard]] vpColVector filter(const vpColVector& v, const vpHomogeneousMatrix& wMc, double dt,
-                                   bool object_tracked, double frame_age);
+                                   bool object_tracked, double frame_age, bool pose_known = true);
   /// \brief What the filter did to the last command.
   [[nodiscard]] SafetyAction last_action() const { return action_; }
   /// \brief Forgets the previous command (the robot is at rest).
