@@ -221,25 +221,16 @@ Command add_perceive_command(CLI::App& app) {
               std::vector<StampedPose> used, truth;
               perception::PoseSource pose_source;
 #ifdef OFV_HAVE_ODOMETRY
-              std::map<odometry::OdometryStatus, long> statuses;
+              std::map<std::string, long> statuses;
               std::vector<double> odometry_ms;
-              std::unique_ptr<odometry::Odometry> odometry;
               if (use_odometry) {
-                odometry = std::make_unique<odometry::Odometry>(odometry_settings);
-                pose_source = [&](const RgbdFrame& frame, std::optional<double> object_depth) {
-                  const odometry::OdometryResult r = odometry->step(frame, object_depth);
-                  ++statuses[r.status];
-                  odometry_ms.push_back(r.diagnostics.ms);
-                  perception::FramePose pose;
-                  pose.wMc = r.wMc;
-                  pose.ok = r.status == odometry::OdometryStatus::Ok || r.status == odometry::OdometryStatus::FirstFrame;
-                  pose.source = "odometry";
-                  pose.status = odometry::to_string(r.status);
-                  const odometry::OdometryDiagnostics& d = r.diagnostics;
-                  pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
-                                      {"inlier_fraction", d.inlier_fraction}, {"residual_m", d.residual},
-                                      {"translation_m", d.translation},       {"rotation_deg", d.rotation},
-                                      {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
+                pose_source = [&statuses, &odometry_ms, steps = odometry::odometry_pose_source(odometry_settings)](
+                                  const RgbdFrame& frame, std::optional<double> object_depth) {
+                  perception::FramePose pose = steps(frame, object_depth);
+                  ++statuses[pose.status];
+                  for (const auto& [name, value] : pose.diagnostics) {
+                    if (name == "ms") odometry_ms.push_back(value);
+                  }
                   return pose;
                 };
               }
@@ -267,13 +258,17 @@ Command add_perceive_command(CLI::App& app) {
                                                    : "")
                         << '\n';
 #ifdef OFV_HAVE_ODOMETRY
-              if (odometry) {
+              if (use_odometry) {
                 std::ostringstream text;
                 text << std::fixed << std::setprecision(2);
                 std::sort(odometry_ms.begin(), odometry_ms.end());
                 text << "ofv perceive: odometry " << odometry::to_string(odometry_settings.method) << ": median "
                      << (odometry_ms.empty() ? 0.0 : odometry_ms[odometry_ms.size() / 2]) << " ms/frame;";
-                for (const auto& [status, count] : statuses) text << ' ' << odometry::to_string(status) << ' ' << count;
+                for (const auto status : {odometry::OdometryStatus::Ok, odometry::OdometryStatus::FirstFrame,
+                                          odometry::OdometryStatus::Failed, odometry::OdometryStatus::Implausible}) {
+                  const auto n = statuses.find(odometry::to_string(status));
+                  if (n != statuses.end()) text << ' ' << n->first << ' ' << n->second;
+                }
                 std::cerr << text.str() << '\n';
                 // ofv's own recordings and TUM sequences carry ground truth.
                 if (fs::exists(fs::path(opt->source) / "groundtruth.txt")) {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -317,6 +318,28 @@ OdometryMethod parse_method(const std::string& what, const std::string& word) {
                                      {"rgbd_icp", OdometryMethod::RgbdIcp},
                                      {"fast_icp", OdometryMethod::FastIcp},
                                      {"rgbd", OdometryMethod::Rgbd}});
+}
+
+FramePose frame_pose(const OdometryResult& r) {
+  FramePose pose;
+  pose.wMc = r.wMc;
+  pose.ok = r.status == OdometryStatus::Ok || r.status == OdometryStatus::FirstFrame;
+  pose.source = "odometry";
+  pose.status = to_string(r.status);
+  const OdometryDiagnostics& d = r.diagnostics;
+  pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
+                      {"inlier_fraction", d.inlier_fraction}, {"residual_m", d.residual},
+                      {"translation_m", d.translation},       {"rotation_deg", d.rotation},
+                      {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
+  return pose;
+}
+
+PoseSource odometry_pose_source(const OdometrySettings& settings) {
+  // Shared: std::function copies the callable, and every copy is one sequence.
+  auto odometry = std::make_shared<Odometry>(settings);
+  return [odometry](const RgbdFrame& frame, std::optional<double> object_depth) {
+    return frame_pose(odometry->step(frame, object_depth));
+  };
 }
 
 }  // namespace ofv::odometry

@@ -13,7 +13,7 @@
  * pixels (Implausible), is a status: the pose stays the last good one.
  *
  * \code
- * ofv::odometry::Odometry odometry;  // ICPOdometry against a keyframe
+ * ofv::odometry::Odometry odometry;  // ICPOdometry against a keyframe (or: odometry_pose_source())
  * while (auto frame = source->next()) {
  *   const ofv::odometry::OdometryResult r = odometry.step(*frame);
  *   if (r.status == ofv::odometry::OdometryStatus::Ok) frame->wMc = r.wMc;
@@ -22,6 +22,7 @@
  */
 #pragma once
 
+#include "ofv/pose_source.h"
 #include "ofv/rgbd_frame.h"
 #include "ofv/settings_table.h"
 
@@ -143,6 +144,23 @@ class Odometry {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/**
+ * \brief A step's outcome as a pose source's answer (ofv::FramePose): the
+ *        pose, ok for Ok and FirstFrame, source `odometry`, the status's word
+ *        and the diagnostics (valid_fraction, masked_fraction,
+ *        inlier_fraction, residual_m, translation_m, rotation_deg, keyframe, ms).
+ */
+[[nodiscard]] FramePose frame_pose(const OdometryResult& result);
+
+/**
+ * \brief RGB-D odometry as a pose source (ofv::PoseSource) for perceive(),
+ *        ofv::servo::run_on_robot (RobotLoopOptions::pose_source) and the
+ *        simulated episode (setting `poses`): one Odometry over the frames
+ *        it is called with, shared by the copies of the function.
+ * \throws std::invalid_argument naming the setting that is invalid.
+ */
+[[nodiscard]] PoseSource odometry_pose_source(const OdometrySettings& settings = {});
 
 /// \brief Throws std::invalid_argument naming the first invalid setting and its value.
 void validate(const OdometrySettings& settings);
