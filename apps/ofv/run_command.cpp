@@ -106,15 +106,17 @@ class CommandLines {
   CommandLines& operator=(const CommandLines&) = delete;
 
   /// One JSON line per command: frame, time, status, twist (17 digits),
-  /// safety action, the loop's mode, the guard that moved it and the
+  /// safety action, with a pose source its word for the frame's pose (ok,
+  /// first_frame, failed, implausible), the loop's mode, the guard that moved it and the
   /// proposer of the target, the confirmed occluder tracks seen in the frame
   /// (id, position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
   void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,
-             const servo::LoopStep* step = nullptr, const std::string& bad_frame = {}) {
+             const servo::LoopStep* step = nullptr, const std::string& bad_frame = {}, const FramePose* pose = nullptr) {
     if (!out_ || closed_) return;
     std::fprintf(out_, "{\"frame\": %ld, \"t\": %.17g, \"status\": \"%s\", \"v\": [", frame, t, status);
     for (unsigned i = 0; i < 6; ++i) std::fprintf(out_, "%s%.17g", i ? ", " : "", v[i]);
     std::fprintf(out_, "], \"safety\": \"%s\", ", safety);
+    if (pose) std::fprintf(out_, "\"pose\": %s, ", nlohmann::json(pose->status).dump().c_str());
     if (!bad_frame.empty()) std::fprintf(out_, "\"bad_frame\": %s, ", nlohmann::json(bad_frame).dump().c_str());
     if (step) {
       std::fprintf(out_, "\"mode\": \"%s\", \"guard\": \"%s\", \"proposer\": \"%s\", ", to_string(step->mode),
@@ -174,6 +176,7 @@ Command add_run_command(CLI::App& app) {
     std::string emc;
     std::string box, rect;
     std::vector<std::string> sets;
+    std::string poses;
     bool dry_run = false;
     bool display = false;
   };
@@ -192,6 +195,11 @@ Command add_run_command(CLI::App& app) {
   sub->add_option("--set", opt->sets, "Any setting of 'ofv simulate' as name=value (repeatable), same defaults")
       ->type_name("NAME=VALUE");
   add_selection_options(*sub, opt->box, opt->rect);
+  sub->add_option("--poses", opt->poses,
+                  "The camera pose the front end and the loop get: robot (the robot's on a live sensor, else the "
+                  "recording's or the simulated arm's; default) or odometry[:icp|rgbd_icp|fast_icp|rgbd] (RGB-D "
+                  "odometry from the first frame's pose); a frame whose pose odometry cannot tell stops the robot "
+                  "(safety \"pose unknown\"): setting poses");
   sub->add_flag("--dry-run", opt->dry_run,
                 "Print every command (JSON lines, then the final stop) instead of sending it to hardware");
 #if defined(OFV_HAVE_DISPLAY)
@@ -227,7 +235,9 @@ Command add_run_command(CLI::App& app) {
               std::vector<std::pair<std::string, std::string>> settings;
               for (const auto& a : opt->sets) settings.push_back(split_assignment(a));
               refuse_set_against_flag(settings, "robot", "--robot", robot_flag->count() > 0, opt->robot);
+              refuse_set_against_flag(settings, "poses", "--poses", !opt->poses.empty(), opt->poses);
               if (!real) settings.insert(settings.begin(), {"robot", opt->robot});
+              if (!opt->poses.empty()) settings.insert(settings.begin(), {"poses", opt->poses});
               // The windows open once the settings are valid, before a driver
               // starts or a source opens: no display is an error at start.
               const auto open_display = [&] {
@@ -295,7 +305,7 @@ Command add_run_command(CLI::App& app) {
               bool user_quit = false;  // the display's quit, not a signal
               const auto print = [&](const servo::RobotLoopFrame& f) {
                 lines.print(f.index, f.frame->timestamp, to_string(f.step->status), f.step->velocity,
-                            to_string(f.step->safety), f.step, f.bad_frame);
+                            to_string(f.step->safety), f.step, f.bad_frame, f.pose);
 #if defined(OFV_HAVE_DISPLAY)
                 // The user ending the run stops it as SIGTERM does.
                 if (display && !display->observe(f)) {
@@ -321,6 +331,7 @@ Command add_run_command(CLI::App& app) {
               options.move_robot = !opt->dry_run || !real;  // simulated robots follow a dry run
               options.max_duration = setup.duration;
               options.stop = &g_stop;
+              options.pose_source = episode_pose_source(setup);
               perception::PerceptionSettings front_end = front_end_settings(setup);
               front_end.selection = selection;
               perception::PerceptionObserver perception(front_end);
@@ -349,6 +360,10 @@ Command add_run_command(CLI::App& app) {
                                                                      : ", stopped by a signal")
                                             : "")
                         << (summary.bad_frames > 0 ? ", " + std::to_string(summary.bad_frames) + " bad frame(s) skipped" : "")
+                        << (options.pose_source ? ", poses " + poses_word(setup) + ": " +
+                                                      std::to_string(summary.pose_unknown) +
+                                                      " unknown (the robot stopped for each)"
+                                                : "")
                         << (summary.watchdog_stops > 0
                                 ? "; the watchdog stopped the robot " + std::to_string(summary.watchdog_stops) +
                                       " time(s) while no frame came"

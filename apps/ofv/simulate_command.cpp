@@ -46,6 +46,7 @@ Command add_simulate_command(CLI::App& app) {
     std::string robot;
     std::vector<std::string> sets;
     std::string perception;
+    std::string poses;
     std::string out;
     std::string record;
     int seed = 0;
@@ -62,12 +63,16 @@ Command add_simulate_command(CLI::App& app) {
   sub->add_option("--set", opt->sets, "Override a setting: name=value (repeatable; the settings are listed below)")
       ->type_name("NAME=VALUE");
   sub->add_option("--perception", opt->perception, "full (the front end, default), labels (the same with the rendered labels in place of segmentation and classification) or ground-truth (the simulator's supervoxels and every occluder in the sphere)");
+  sub->add_option("--poses", opt->poses,
+                  "The camera pose the front end and the loop get: simulator (the true pose, default) or "
+                  "odometry[:icp|rgbd_icp|fast_icp|rgbd] (RGB-D odometry from the first frame's pose; the renderer and "
+                  "the metrics keep the true pose; needs perception full or labels): setting poses");
   CLI::Option* seed_flag = sub->add_option("--seed", opt->seed, "The scenario's k-th random world: sensor noise and, for k > 0, occluder timing and placement within the scenario's variation (0 = as written)")->capture_default_str();
   sub->add_option("--out", opt->out, "Output folder (default: out/simulate/SCENARIO)");
   sub->add_flag("!--no-pictures", opt->pictures, "Skip the PNG pictures");
   sub->add_option("--record", opt->record,
-                  "Also write every frame the loop saw as a TUM RGB-D sequence in this folder, with the camera poses it "
-                  "had: 'ofv run --robot camera --source DIR --dry-run' with the same settings replays the same commands");
+                  "Also write every frame the loop saw as a TUM RGB-D sequence in this folder, with the true camera poses "
+                  "(also with --poses odometry): 'ofv run --robot camera --source DIR --dry-run' with the same settings replays the same commands");
   sub->add_flag("--video", opt->video, "Also write episode.avi: the scene view and the camera's view, frame by frame (MJPEG)");
   sub->add_flag("--real-time", opt->real_time,
                 "Run the arm on ViSP's threaded simulator (vpSimulatorViper850/Afma6) in wall-clock time: a "
@@ -107,11 +112,13 @@ Command add_simulate_command(CLI::App& app) {
               if (!opt->robot.empty()) settings.emplace_back("robot", opt->robot);
               if (opt->real_time) settings.emplace_back("real_time", "true");
               if (!opt->perception.empty()) settings.emplace_back("perception", opt->perception);
+              if (!opt->poses.empty()) settings.emplace_back("poses", opt->poses);
               settings.emplace_back("seed", std::to_string(opt->seed));
               std::vector<std::pair<std::string, std::string>> sets;
               for (const auto& a : opt->sets) sets.push_back(split_assignment(a));
               refuse_set_against_flag(sets, "robot", "--robot", !opt->robot.empty(), opt->robot);
               refuse_set_against_flag(sets, "perception", "--perception", !opt->perception.empty(), opt->perception);
+              refuse_set_against_flag(sets, "poses", "--poses", !opt->poses.empty(), opt->poses);
               refuse_set_against_flag(sets, "seed", "--seed", seed_flag->count() > 0, std::to_string(opt->seed));
               refuse_set_against_flag(sets, "real_time", "--real-time", opt->real_time, "true");
               settings.insert(settings.end(), sets.begin(), sets.end());
@@ -182,7 +189,7 @@ Command add_simulate_command(CLI::App& app) {
                         << to_string(setup.loop.method)
                         << (setup.loop.method == ViewMethod::Hindsight ? std::string(" (no perception: the plan)")
                                                                        : ", perception " + std::string(to_string(setup.perception)))
-                        << '\n'
+                        << (setup.poses == PoseOrigin::Frame ? std::string() : ", poses " + poses_word(setup)) << '\n'
                         << episode_summary(outcome.metrics) << "  wrote " << written.size() << " files in " << dir.string()
                         << " (trajectory.csv, metrics.json ...)";
               if (!opt->record.empty()) std::cout << "; frames recorded in " << opt->record;

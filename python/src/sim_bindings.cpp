@@ -69,9 +69,11 @@ const TrajectoryColumns& trajectory_columns() {
     TrajectoryColumns out;
     out.names = split(trajectory_csv_header(), ',');
     // A column is a number (an empty field: none) unless a record writes a
-    // word there (status, safety: None writes nothing, so a record with an action).
+    // word there (status, safety: None writes nothing, so a record with an
+    // action; pose_status: the simulator's pose writes nothing, so a record with one).
     StepRecord words;
     words.safety = servo::SafetyAction::SpeedLimit;
+    words.pose.emplace().status = "ok";
     for (const auto& field : split(trajectory_csv_row(words), ',')) out.numeric.push_back(numeric_field(field));
     if (out.names.size() != out.numeric.size()) throw std::logic_error("trajectory.csv: header and row differ in length");
     return out;

@@ -4,6 +4,9 @@
 #include "ofv/servo/target_pose.h"
 #include "ofv/sim/live_source.h"
 #include "ofv/sim/renderer.h"
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+#include "ofv/odometry/odometry.h"
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +23,43 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+#ifndef OFV_LOOP_HAVE_ODOMETRY
+// What OpenCV's contrib module the odometry needs, for the errors of a build without it.
+constexpr const char* kNoOdometry =
+    "needs RGB-D odometry, which this ofv was built without: it needs OpenCV's rgbd module (opencv_contrib; "
+    "Debian's libopencv-contrib-dev)";
+#endif
+
+// Setting `poses`: simulator | robot | odometry[:METHOD].
+void set_poses(EpisodeSetup& e, const std::string& word) {
+  if (word == "simulator" || word == "robot") {
+    e.poses = PoseOrigin::Frame;
+    e.odometry_method.clear();
+    return;
+  }
+  const std::string prefix = "odometry";
+  const bool odometry = word.rfind(prefix, 0) == 0 &&
+                        (word.size() == prefix.size() || (word[prefix.size()] == ':' && word.size() > prefix.size() + 1));
+  if (!odometry) {
+    throw std::invalid_argument("setting 'poses' must be one of " + std::string(kPosesWords) + ", got \"" + word + "\"");
+  }
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+  const std::string method = word.size() > prefix.size() ? word.substr(prefix.size() + 1) : std::string();
+  if (!method.empty()) {
+    try {
+      (void)odometry::parse_method("poses", method);
+    } catch (const std::invalid_argument&) {
+      throw std::invalid_argument("setting 'poses' must be one of " + std::string(kPosesWords) + ", got \"" + word +
+                                  "\"");
+    }
+  }
+  e.poses = PoseOrigin::Odometry;
+  e.odometry_method = method;
+#else
+  throw std::invalid_argument("setting poses = " + word + " " + kNoOdometry);
+#endif
 }
 
 SettingsTable<EpisodeSetup> make_table() {
@@ -69,6 +109,12 @@ SettingsTable<EpisodeSetup> make_table() {
          "method hindsight: the planner's time step, in frame periods"},
         [](E& e, const std::string& v) { e.hindsight.frames_per_step = static_cast<int>(parse_integer("hindsight_step", v, 1, 30)); },
         [](const E& e) { return std::to_string(e.hindsight.frames_per_step); });
+  t.add({"poses", "simulator | robot | odometry[:icp|rgbd_icp|fast_icp|rgbd]", poses_word(d), "",
+         "the camera pose the front end and the loop get: the frame's own (simulator: the true pose; ofv run: the "
+         "robot's or the recording's; robot says the same), or RGB-D odometry from the first frame's pose (OpenCV's "
+         "rgbd module; the renderer and the metrics keep the true pose); a frame whose pose odometry cannot tell "
+         "stops the robot"},
+        [](E& e, const std::string& v) { set_poses(e, v); }, [](const E& e) { return poses_word(e); });
   t.add({"real_time", "bool", format_bool(d.real_time), "",
          "run the arm on ViSP's threaded simulator in wall-clock time (robot viper850 or afma6)"},
         [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); },
@@ -141,6 +187,35 @@ class TruthObserver final : public Observer {
   perception::PerceptionSettings settings_;
 };
 
+// The pose a pose source gave, against the true one.
+PoseRecord pose_record(const std::string& source, const FramePose& pose, const Eigen::Isometry3d& wMc_true) {
+  PoseRecord p;
+  p.source = source;
+  p.status = pose.status;
+  p.known = pose.ok;
+  p.wMc = pose.wMc;
+  p.translation_error = (pose.wMc.translation() - wMc_true.translation()).norm();
+  p.rotation_error = Eigen::AngleAxisd(wMc_true.linear().transpose() * pose.wMc.linear()).angle() * 180.0 / M_PI;
+  return p;
+}
+
+// A frame with a pose source's pose while the front end looks at it (and
+// its scores are taken: the front end's world is that pose's); then its own
+// again (the true pose) for the records, pictures and recordings.
+class AtPose {
+ public:
+  AtPose(RgbdFrame& frame, const std::optional<FramePose>& pose) : frame_(frame), own_(frame.wMc) {
+    if (pose) frame_.wMc = pose->wMc;
+  }
+  ~AtPose() { frame_.wMc = own_; }
+  AtPose(const AtPose&) = delete;
+  AtPose& operator=(const AtPose&) = delete;
+
+ private:
+  RgbdFrame& frame_;
+  Eigen::Isometry3d own_;
+};
+
 // What the loop did.
 void record_step(StepRecord& rec, const servo::LoopStep& step) {
   rec.times.estimate = step.estimate_s;
@@ -200,6 +275,22 @@ perception::PerceptionSettings front_end_settings(const EpisodeSetup& setup) {
   return settings;
 }
 
+std::string poses_word(const EpisodeSetup& setup) {
+  if (setup.poses == PoseOrigin::Frame) return "simulator";
+  return setup.odometry_method.empty() ? "odometry" : "odometry:" + setup.odometry_method;
+}
+
+PoseSource episode_pose_source(const EpisodeSetup& setup) {
+  if (setup.poses == PoseOrigin::Frame) return {};
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+  odometry::OdometrySettings settings;
+  if (!setup.odometry_method.empty()) settings.method = odometry::parse_method("poses", setup.odometry_method);
+  return odometry::odometry_pose_source(settings);
+#else
+  throw std::invalid_argument("setting poses = " + poses_word(setup) + " " + kNoOdometry);
+#endif
+}
+
 const char* to_string(PerceptionMode mode) {
   switch (mode) {
     case PerceptionMode::Full: return "full";
@@ -239,6 +330,20 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
   if (s.loop.method == ViewMethod::Hindsight) {
     sim::check_hindsight(planner_settings(s), s.loop.estimator.resolve().r_sphere, s.duration, s.scenario.rate);
   }
+  if (s.poses != PoseOrigin::Frame) {
+    // The ground truth and the plan are the simulator's, poses included:
+    // nothing there would read a pose odometry estimated.
+    if (s.perception == PerceptionMode::GroundTruth) {
+      throw std::invalid_argument("setting poses = " + poses_word(s) +
+                                  " needs perception full or labels: with perception = ground-truth the loop's input "
+                                  "is the simulator's, in its true camera frame, and no pose estimate would be used");
+    }
+    if (s.loop.method == ViewMethod::Hindsight) {
+      throw std::invalid_argument("setting poses = " + poses_word(s) +
+                                  " does not go with method = hindsight: the plan is followed from the true poses, "
+                                  "without perception");
+    }
+  }
   if (s.real_time && s.robot == servo::RobotKind::Camera) {
     throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");
   }
@@ -255,6 +360,11 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   std::unique_ptr<servo::CameraRobot> robot = servo::make_robot(setup.robot, servo::to_visp(scenario.wMc_start), setup.real_time);
   const perception::PerceptionSettings front_end = front_end_settings(setup);
   std::optional<perception::PerceptionObserver> perception;  // full, labels: made on the first frame, which may point out the object
+  // Setting poses: the pose the front end and the loop get, from the
+  // frames (the renderer keeps rendering from the true pose).
+  const PoseSource pose_source = episode_pose_source(setup);
+  const std::string poses = poses_word(setup);
+  std::optional<double> object_depth;  // the object's nearest depth in the last frame, for the pose source
 
   // Method hindsight: the path planned from the whole episode, followed a
   // controller time constant (the adaptive gain's at zero error) plus the
@@ -303,10 +413,23 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
         if (setup.select == ObjectSelect::Labels) settings.selection = object_in(rendered.frame.labels);
         perception.emplace(settings);
       }
-      observation = perception ? perception->observe(rendered.frame)
-                               : truth_observation(rendered.frame, std::move(gt_problem), front_end);
-      rec.times.perception = seconds_since(start);
-      if (perception) rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
+      if (perception) {
+        std::optional<FramePose> pose;
+        if (pose_source) {
+          pose = pose_source(rendered.frame, object_depth);
+          rec.pose = pose_record(poses, *pose, wMc);
+        }
+        const AtPose at(rendered.frame, pose);
+        observation = perception->observe(rendered.frame);
+        observation->pose = !pose || pose->ok ? PoseStatus::Known : PoseStatus::Unknown;
+        rec.times.perception = seconds_since(start);
+        object_depth =
+            observation->problem ? nearest_depth(observation->problem->positions, observation->wMc) : std::nullopt;
+        rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
+      } else {
+        observation = truth_observation(rendered.frame, std::move(gt_problem), front_end);
+        rec.times.perception = seconds_since(start);
+      }
       observation->age = age;
       step = loop.step(*observation, dt);
     }
@@ -354,6 +477,8 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
   options.wall_clock_age = true;
   options.first_period = 1.0 / setup.scenario.rate;
   options.stop = stop;
+  options.pose_source = episode_pose_source(setup);
+  const std::string poses = poses_word(setup);
   perception::PerceptionSettings front_end = front_end_settings(setup);
   if (setup.perception != PerceptionMode::GroundTruth && setup.select == ObjectSelect::Labels) {
     // The first frame's labels, rendered from where the arm starts.
@@ -375,7 +500,15 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     rec.wMc = f.frame->wMc;
     (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
     rec.occluders_in_view = sim::occluders_seen(f.frame->labels);
-    if (perception) rec.perception = score(*f.frame, perception->last(), renderer, front_end);
+    if (f.pose) rec.pose = pose_record(poses, *f.pose, rec.wMc);
+    if (perception && f.pose) {
+      // Scored as the front end saw it: with the pose source's pose.
+      RgbdFrame seen = *f.frame;
+      seen.wMc = f.pose->wMc;
+      rec.perception = score(seen, perception->last(), renderer, front_end);
+    } else if (perception) {
+      rec.perception = score(*f.frame, perception->last(), renderer, front_end);
+    }
     rec.times.render = f.source_s;
     rec.times.perception = f.perception_s;
     record_step(rec, *f.step);

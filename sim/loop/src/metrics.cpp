@@ -1,9 +1,15 @@
 // Episode summary and trajectory rows.
 #include "ofv/loop/metrics.h"
 
+#include "ofv/sources/sequence_files.h"
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+#include "ofv/odometry/evaluation.h"
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <tuple>
 #include <iomanip>
 #include <sstream>
 
@@ -60,6 +66,38 @@ PerceptionSummary summarise_perception(const std::vector<StepRecord>& steps) {
     p.lost_half_visible += scored && !s.perception.centroid_error && s.visible_fraction >= 0.5 ? 1 : 0;
   }
   return p;
+}
+
+// The poses block: the steps' pose records against their true poses.
+std::optional<PoseSummary> summarise_poses(const std::vector<StepRecord>& steps) {
+  std::optional<PoseSummary> out;
+  std::map<std::string, int> statuses;
+  std::vector<StampedPose> used, truth;
+  for (const StepRecord& s : steps) {
+    if (!s.pose) continue;
+    if (!out) out.emplace().source = s.pose->source;
+    PoseSummary& p = *out;
+    ++statuses[s.pose->status];
+    p.unknown += s.pose->known ? 0 : 1;
+    if (s.pose->translation_error > p.max_translation_error) {
+      p.max_translation_error = s.pose->translation_error;
+      p.max_translation_error_time = s.time;
+    }
+    p.max_rotation_error = std::max(p.max_rotation_error, s.pose->rotation_error);
+    used.push_back({s.time, s.pose->wMc});
+    truth.push_back({s.time, s.wMc});
+  }
+  if (!out) return out;
+  out->status_counts.assign(statuses.begin(), statuses.end());
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+  // Every step is its own association: the same time stamps.
+  std::tie(out->ate, out->ate_max) = odometry::absolute_trajectory_error(used, truth, 0.0);
+#else
+  // Pose records come only from the odometry component; without it (a
+  // summary of records made elsewhere) the ATE is not measured.
+  out->ate = out->ate_max = std::nan("");
+#endif
+  return out;
 }
 
 }  // namespace
@@ -164,6 +202,7 @@ EpisodeMetrics summarise(const std::vector<StepRecord>& steps, double threshold,
   }
   if (m.unrecovered_occlusions == 0) m.max_recovery_time = worst;
   m.perception = summarise_perception(steps);
+  m.poses = summarise_poses(steps);
   return m;
 }
 
@@ -227,6 +266,14 @@ std::string episode_summary(const EpisodeMetrics& m) {
         << h.evaluations << " evaluations, planned in " << std::setprecision(1) << h.plan_s << " s"
         << std::setprecision(3);
   }
+  if (m.poses) {
+    const PoseSummary& p = *m.poses;
+    out << "\n  poses: " << p.source << ", ATE " << 1000.0 * p.ate << " mm (max " << 1000.0 * p.ate_max
+        << "), worst error " << 1000.0 * p.max_translation_error << " mm at " << p.max_translation_error_time << " s, "
+        << p.max_rotation_error << " deg;";
+    for (const auto& [status, count] : p.status_counts) out << ' ' << status << ' ' << count;
+    if (p.unknown > 0) out << "; the loop stopped for " << p.unknown << " frame(s) of unknown pose";
+  }
   out << "\n  distance to the sphere: max " << 100.0 * m.max_sphere_distance_error << " cm; path " << m.path_length
       << " m; mean angular error " << m.mean_angular_error_deg << " deg\n"
       << "  compute per step: " << 1e3 * m.mean_times.total() << " ms (render " << 1e3 * m.mean_times.render
@@ -242,7 +289,7 @@ std::string trajectory_csv_header() {
          "predicted_occluders,"
          "render_s,perception_s,estimate_s,control_s,"
          "object_precision,object_recall,occluder_precision,occluder_recall,centroid_error,hidden_error,"
-         "mode,guard,proposer,estimator_calls";
+         "mode,guard,proposer,estimator_calls,pose_status,pose_error_m,pose_error_deg";
 }
 
 std::string trajectory_csv_row(const StepRecord& s) {
@@ -274,7 +321,13 @@ std::string trajectory_csv_row(const StepRecord& s) {
     if (s.perception.*score) out << *(s.perception.*score);
   }
   out << ',' << to_string(s.mode) << ',' << to_string(s.guard) << ',' << to_string(s.proposer) << ','
-      << s.estimator_calls;
+      << s.estimator_calls << ',';
+  // The simulator's own pose: no status, no error.
+  if (s.pose) {
+    out << s.pose->status << ',' << s.pose->translation_error << ',' << s.pose->rotation_error;
+  } else {
+    out << ",,";
+  }
   return out.str();
 }
 

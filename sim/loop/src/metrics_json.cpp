@@ -1,6 +1,8 @@
 // EpisodeMetrics <-> JSON.
 #include "ofv/loop/metrics_json.h"
 
+#include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -97,6 +99,35 @@ HindsightBound hindsight_from_json(const json& j) {
   return h;
 }
 
+json poses_to_json(const PoseSummary& p) {
+  json statuses = json::object();
+  for (const auto& [status, count] : p.status_counts) statuses[status] = count;
+  // Not measured (NaN, a build without odometry): null.
+  const auto number = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
+  return {{"source", p.source},
+          {"ate_m", number(p.ate)},
+          {"ate_max_m", number(p.ate_max)},
+          {"status_counts", statuses},
+          {"unknown_frames", p.unknown},
+          {"max_translation_error_m", p.max_translation_error},
+          {"max_translation_error_time_s", p.max_translation_error_time},
+          {"max_rotation_error_deg", p.max_rotation_error}};
+}
+
+PoseSummary poses_from_json(const json& j) {
+  PoseSummary p;
+  const auto number = [](const json& x) { return x.is_null() ? std::nan("") : x.get<double>(); };
+  p.source = j.at("source").get<std::string>();
+  p.ate = number(j.at("ate_m"));
+  p.ate_max = number(j.at("ate_max_m"));
+  for (const auto& [status, count] : j.at("status_counts").items()) p.status_counts.emplace_back(status, count.get<int>());
+  p.unknown = j.at("unknown_frames").get<int>();
+  p.max_translation_error = j.at("max_translation_error_m").get<double>();
+  p.max_translation_error_time = j.at("max_translation_error_time_s").get<double>();
+  p.max_rotation_error = j.at("max_rotation_error_deg").get<double>();
+  return p;
+}
+
 }  // namespace
 
 json metrics_to_json(const EpisodeMetrics& m) {
@@ -133,7 +164,8 @@ json metrics_to_json(const EpisodeMetrics& m) {
           {"status_counts", statuses},
           {"mode_counts", modes},
           {"perception", perception_to_json(m.perception)},
-          {"hindsight_bound", m.hindsight ? hindsight_to_json(*m.hindsight) : json()}};
+          {"hindsight_bound", m.hindsight ? hindsight_to_json(*m.hindsight) : json()},
+          {"poses", m.poses ? poses_to_json(*m.poses) : json()}};
 }
 
 EpisodeMetrics metrics_from_json(const json& j) {
@@ -172,6 +204,8 @@ EpisodeMetrics metrics_from_json(const json& j) {
   // Episodes written before the perception scores have none.
   if (j.contains("perception")) m.perception = perception_from_json(j.at("perception"));
   if (j.contains("hindsight_bound") && !j.at("hindsight_bound").is_null()) m.hindsight = hindsight_from_json(j.at("hindsight_bound"));
+  // Episodes written before the poses block (or with the simulator's poses) have none.
+  if (j.contains("poses") && !j.at("poses").is_null()) m.poses = poses_from_json(j.at("poses"));
   return m;
 }
 

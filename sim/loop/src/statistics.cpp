@@ -68,6 +68,11 @@ const std::vector<MetricColumn>& metric_columns() {
       {"occluder_precision", "occl. precision", [](const EpisodeMetrics& m) { return mean_score(m.perception.occluder_precision); }},
       {"occluder_recall", "occl. recall", [](const EpisodeMetrics& m) { return mean_score(m.perception.occluder_recall); }},
       {"centroid_error_cm", "centroid err. [cm]", [](const EpisodeMetrics& m) { return 100.0 * mean_score(m.perception.centroid_error); }},
+      // The poses a pose source gave the loop (setting poses; n/a with the simulator's).
+      {"pose_ate_mm", "pose ATE [mm]", [](const EpisodeMetrics& m) { return m.poses ? 1e3 * m.poses->ate : std::nan(""); }},
+      {"pose_unknown_frames", "pose unknown [frames]", [](const EpisodeMetrics& m) {
+         return m.poses ? static_cast<double>(m.poses->unknown) : std::nan("");
+       }},
   };
   return c;
 }

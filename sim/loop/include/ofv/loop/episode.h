@@ -12,6 +12,7 @@
 #include "ofv/loop/compare.h"
 #include "ofv/loop/metrics.h"
 #include "ofv/perception/perception.h"
+#include "ofv/pose_source.h"
 #include "ofv/rgbd_frame.h"
 #include "ofv/servo/robot.h"
 #include "ofv/servo/robot_loop.h"
@@ -50,6 +51,17 @@ enum class ObjectSelect {
 /// \brief The word in settings and files: labels, auto.
 [[nodiscard]] const char* to_string(ObjectSelect select);
 
+/// \brief Where the camera pose the front end and the loop get comes from (setting `poses`).
+enum class PoseOrigin {
+  /// The pose each frame comes with: in simulation the true one (the
+  /// simulator's), in `ofv run` the robot's or the recording's (`simulator`, `robot`).
+  Frame,
+  /// RGB-D odometry (ofv::odometry, built with OpenCV's rgbd module) from
+  /// the first frame's own pose (`odometry[:METHOD]`); the renderer and
+  /// the metrics keep the true pose.
+  Odometry,
+};
+
 /**
  * \brief Everything an episode needs, resolved and validated.
  *
@@ -80,13 +92,19 @@ struct EpisodeSetup {
   /// Method hindsight: the planner's lattice spacing and time step (settings
   /// hindsight_spacing, hindsight_step); its speed limit is the loop's max_linear_speed.
   sim::HindsightSettings hindsight;
+  PoseOrigin poses = PoseOrigin::Frame;  ///< setting `poses`
+  /// With PoseOrigin::Odometry: OpenCV's method, a word of
+  /// ofv::odometry::parse_method (icp, rgbd_icp, fast_icp, rgbd); empty for
+  /// the odometry's default. (A word, not the odometry's enum: that
+  /// component is optional.)
+  std::string odometry_method;
 };
 
 /**
  * \brief Every setting of an episode by name: the loop's
  *        (ofv::servo::loop_settings_table()), the front end's
  *        (ofv::perception::perception_settings_table()) and robot, perception, select,
- *        duration, seed, latency, real_time, hindsight_spacing, hindsight_step. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        duration, seed, latency, real_time, hindsight_spacing, hindsight_step, poses. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
 [[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();
@@ -104,6 +122,23 @@ struct EpisodeSetup {
 ///        and seed resolution, the setup's front_end, labels as classes with
 ///        perception=labels (the object selection left as the default).
 [[nodiscard]] perception::PerceptionSettings front_end_settings(const EpisodeSetup& setup);
+
+/// \brief The words of setting `poses`, for messages: simulator, robot, odometry, odometry:icp, ...
+inline constexpr const char* kPosesWords =
+    "simulator, robot, odometry, odometry:icp, odometry:rgbd_icp, odometry:fast_icp, odometry:rgbd";
+
+/// \brief The setting `poses` of a setup as a word: simulator, or odometry[:METHOD].
+[[nodiscard]] std::string poses_word(const EpisodeSetup& setup);
+
+/**
+ * \brief The pose source of setting `poses`: empty for PoseOrigin::Frame (the
+ *        frames' own poses), RGB-D odometry (ofv::odometry::odometry_pose_source,
+ *        default odometry settings) for PoseOrigin::Odometry. A new source,
+ *        with no frame seen yet, at each call.
+ * \throws std::invalid_argument when odometry is asked for and ofv was built
+ *         without it (OpenCV's rgbd module, opencv_contrib), naming the module.
+ */
+[[nodiscard]] PoseSource episode_pose_source(const EpisodeSetup& setup);
 
 /// \brief What happened in one step, for pictures and progress.
 struct StepDetail {

@@ -30,6 +30,22 @@ struct StageTimes {
   [[nodiscard]] double total() const { return render + perception + estimate + control; }
 };
 
+/**
+ * \brief The camera pose the front end and the loop got in one frame, when
+ *        it came from a pose source (setting `poses`: RGB-D odometry), against
+ *        the true pose (StepRecord::wMc).
+ */
+struct PoseRecord {
+  std::string source;  ///< the setting's word: odometry:icp, odometry:rgbd_icp, ...
+  std::string status;  ///< the source's word for the frame: ok, first_frame, failed, implausible
+  /// False when the source could not tell the pose (the loop stopped for
+  /// the frame: ofv::PoseStatus::Unknown, safety "pose unknown").
+  bool known = true;
+  Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< the pose used (world <- camera) [m]
+  double translation_error = 0.0;  ///< |used - true| camera position [m]
+  double rotation_error = 0.0;     ///< angle of the rotation from the true to the used orientation [deg]
+};
+
 /// \brief What happened in one frame period of an episode.
 struct StepRecord {
   double time = 0.0;                                       ///< simulated time [s]
@@ -58,6 +74,9 @@ struct StepRecord {
   /// all empty when the estimator's input is the simulator's ground truth.
   perception::PerceptionScores perception;
   StageTimes times;                   ///< compute time of this step
+  /// The pose the loop got, when not the simulator's (setting `poses`);
+  /// none when it was the true one (`wMc`).
+  std::optional<PoseRecord> pose;
 };
 
 /// \brief One perception score over an episode's frames (those where it is defined).
@@ -119,6 +138,22 @@ struct HindsightBound {
   double plan_s = 0.0;     ///< planning time [s]
 };
 
+/// \brief The poses block of an episode (`metrics.json` "poses"): how far the
+///        pose source's poses were from the truth.
+struct PoseSummary {
+  std::string source;  ///< PoseRecord::source
+  /// Absolute trajectory error: RMS of the position errors after the rigid
+  /// transform that puts the first used pose on the first true one
+  /// (ofv::odometry::absolute_trajectory_error) [m]
+  double ate = 0.0;
+  double ate_max = 0.0;  ///< the largest of those errors [m]
+  std::vector<std::pair<std::string, int>> status_counts;  ///< frames per status word (PoseRecord::status)
+  int unknown = 0;  ///< frames the loop stopped for, the pose not known
+  double max_translation_error = 0.0;  ///< the largest PoseRecord::translation_error (not aligned) [m]
+  double max_translation_error_time = 0.0;  ///< when it was [s]
+  double max_rotation_error = 0.0;     ///< the largest PoseRecord::rotation_error [deg]
+};
+
 /// \brief Summary of an episode.
 struct EpisodeMetrics {
   int steps = 0;                        ///< frame periods (StepRecord) summarised
@@ -144,6 +179,7 @@ struct EpisodeMetrics {
   std::vector<std::pair<std::string, int>> mode_counts;    ///< steps per loop mode (LoopMode)
   PerceptionSummary perception;  ///< empty (scored() false) with ground-truth perception
   std::optional<HindsightBound> hindsight;  ///< method hindsight only
+  std::optional<PoseSummary> poses;  ///< when the steps carry a PoseRecord (setting `poses` not the simulator)
 };
 
 /**
