@@ -128,13 +128,19 @@ struct Odometry::Impl {
     return cv::rgbd::OdometryFrame::create(grey, depth, mask);
   }
 
-  /// Of the used pixels of `src` (sampled), those whose point, moved by `motion` (kMc),
-  /// falls on a reference pixel within max_depth_diff; and their RMS difference.
+  /// Of the used pixels of `src` (sampled) whose point, moved by `motion`
+  /// (kMc), falls on a used pixel of the reference (the overlap: in view, depth
+  /// in range, not masked there), those within max_depth_diff of it; and
+  /// their RMS difference. What the reference did not use (it left the view,
+  /// was masked there or hidden) tells nothing of the motion: counted as
+  /// mismatches, the check failed a right motion whenever the mask changed
+  /// (the object lost, no mask) or the camera saw past the occluders.
   void inliers(const cv::rgbd::OdometryFrame& src, const cv::rgbd::OdometryFrame& ref, const Eigen::Isometry3d& motion,
                OdometryDiagnostics& d) const {
     const CameraIntrinsics& k = intrinsics;
     const Eigen::Matrix3f R = motion.linear().cast<float>();
     const Eigen::Vector3f t = motion.translation().cast<float>();
+    long pixels = 0;
     long samples = 0;
     long matched = 0;
     double sum = 0.0;
@@ -142,8 +148,8 @@ struct Odometry::Impl {
       const auto* zrow = src.depth.ptr<float>(v);
       const auto* mrow = src.mask.ptr<std::uint8_t>(v);
       for (int u = 0; u < k.width; u += kInlierStride) {
+        ++pixels;
         if (mrow[u] == 0) continue;
-        ++samples;
         const float z = zrow[u];
         const Eigen::Vector3f p(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
         const Eigen::Vector3f q = R * p + t;
@@ -154,6 +160,7 @@ struct Odometry::Impl {
         const long vi = std::lround(vq);
         if (!(ui >= 0 && ui < k.width && vi >= 0 && vi < k.height)) continue;
         if (ref.mask.at<std::uint8_t>(static_cast<int>(vi), static_cast<int>(ui)) == 0) continue;
+        ++samples;
         const double diff = ref.depth.at<float>(static_cast<int>(vi), static_cast<int>(ui)) - q.z();
         if (std::abs(diff) <= settings.max_depth_diff) {
           ++matched;
@@ -161,6 +168,7 @@ struct Odometry::Impl {
         }
       }
     }
+    d.overlap_fraction = pixels > 0 ? static_cast<double>(samples) / static_cast<double>(pixels) : 0.0;
     d.inlier_fraction = samples > 0 ? static_cast<double>(matched) / static_cast<double>(samples) : 0.0;
     d.residual = matched > 0 ? std::sqrt(sum / static_cast<double>(matched)) : 0.0;
   }
@@ -269,7 +277,7 @@ OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> obje
   d.rotation = angle(motion.linear()) / kDegree;
   m.inliers(*current, *m.reference, kMc, d);
   if (d.translation > m.settings.max_translation || d.rotation > m.settings.max_rotation ||
-      d.inlier_fraction < m.settings.min_inlier_fraction) {
+      d.overlap_fraction < m.settings.min_overlap_fraction || d.inlier_fraction < m.settings.min_inlier_fraction) {
     return finish(OdometryStatus::Implausible);
   }
   m.wMc = wMc;
@@ -328,7 +336,8 @@ FramePose frame_pose(const OdometryResult& r) {
   pose.status = to_string(r.status);
   const OdometryDiagnostics& d = r.diagnostics;
   pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
-                      {"inlier_fraction", d.inlier_fraction}, {"residual_m", d.residual},
+                      {"overlap_fraction", d.overlap_fraction}, {"inlier_fraction", d.inlier_fraction},
+                      {"residual_m", d.residual},
                       {"translation_m", d.translation},       {"rotation_deg", d.rotation},
                       {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
   return pose;

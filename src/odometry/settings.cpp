@@ -51,9 +51,13 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                180.0, true);
     number_row(t, "min_valid_fraction", &S::min_valid_fraction, "",
                "a frame with fewer of its pixels usable (depth in range, not masked) fails", 0.0, 1.0, false);
+    number_row(t, "min_overlap_fraction", &S::min_overlap_fraction, "",
+               "a step after which fewer of the image's pixels are used and fall on pixels the reference used is "
+               "implausible (too little to judge the match by)",
+               0.0, 1.0, false);
     number_row(t, "min_inlier_fraction", &S::min_inlier_fraction, "",
-               "a step after which fewer of the used pixels fall on the reference within max_depth_diff is "
-               "implausible",
+               "a step after which fewer of the used pixels that fall on pixels the reference used are within "
+               "max_depth_diff of them is implausible",
                0.0, 1.0, false);
     number_row(t, "max_depth_diff", &S::max_depth_diff, "m",
                "pixels of the two frames match when their depths differ by at most this (OpenCV's maxDepthDiff)", 0.0,

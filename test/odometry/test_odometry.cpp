@@ -101,6 +101,33 @@ TEST(Odometry, StartsAtTheFirstFramesPoseAndComposes) {
   EXPECT_LT(error(r.wMc, frame.wMc).first, 4 * kTranslationTolerance);
 }
 
+TEST(Odometry, WhatTheReferenceMaskedTellsNothingOfTheMotion) {
+  // A keyframe masked down to the far part of the scene (the object deep
+  // behind what is left out), then the same view unmasked (the object lost:
+  // no depth for the mask). The pixels the keyframe left out are no
+  // mismatches: the step is Ok, its inliers counted on the overlap.
+  Scene scene("dvd-static");
+  const RgbdFrame first = scene.frame(Eigen::Isometry3d::Identity(), 0);
+  Odometry probe;
+  const double all = probe.step(first).diagnostics.valid_fraction;
+  double depth = 0.0;  // masking at least half of the usable pixels, leaving more than 10 % of the image
+  for (double d = 0.55; d < 1.2 && depth == 0.0; d += 0.01) {
+    Odometry o;
+    const OdometryDiagnostics m = o.step(first, d).diagnostics;
+    if (m.masked_fraction >= 0.5 * all && m.valid_fraction > 0.1) depth = d;
+  }
+  ASSERT_GT(depth, 0.0);
+  Odometry odometry;
+  ASSERT_EQ(odometry.step(first, depth).status, OdometryStatus::FirstFrame);
+  const RgbdFrame second = scene.frame(Eigen::Isometry3d(Eigen::Translation3d(0.005, 0.0, 0.0)), 1);
+  const OdometryResult r = odometry.step(second);
+  ASSERT_EQ(r.status, OdometryStatus::Ok) << to_string(r.status) << " inliers " << r.diagnostics.inlier_fraction
+                                          << " overlap " << r.diagnostics.overlap_fraction;
+  EXPECT_GT(r.diagnostics.inlier_fraction, 0.9);
+  EXPECT_LT(r.diagnostics.overlap_fraction, 0.5 * r.diagnostics.valid_fraction + 0.05);
+  EXPECT_LT(error(r.wMc, second.wMc).first, kTranslationTolerance);
+}
+
 TEST(Odometry, BlankDepthFails) {
   Scene scene("dvd-static");
   Odometry odometry;

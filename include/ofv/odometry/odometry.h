@@ -52,8 +52,9 @@ enum class OdometryStatus {
   Failed,
   /// The frame does not fit the reference: OpenCV found no motion (with
   /// pixels enough), or one that is not finite, larger than max_translation
-  /// or max_rotation, or after which too few pixels match
-  /// (min_inlier_fraction). The pose is the last good one.
+  /// or max_rotation, after which too few pixels fall on the reference's
+  /// (OdometryDiagnostics::overlap_fraction below min_overlap_fraction) or too
+  /// few of those match (min_inlier_fraction). The pose is the last good one.
   Implausible,
 };
 
@@ -70,7 +71,11 @@ struct OdometrySettings {
   double max_translation = 0.05;       ///< a step's motion beyond this is implausible [m per frame]
   double max_rotation = 5.0;           ///< a step's rotation beyond this is implausible [deg per frame]
   double min_valid_fraction = 0.05;    ///< fewer of the image's pixels with usable depth (after the mask): failed
-  double min_inlier_fraction = 0.6;    ///< fewer of the used pixels matching the reference after the motion: implausible
+  /// Fewer of the image's pixels used and falling, after the motion, on
+  /// pixels the reference used (OdometryDiagnostics::overlap_fraction):
+  /// implausible, too little to judge the match by.
+  double min_overlap_fraction = 0.02;
+  double min_inlier_fraction = 0.6;    ///< fewer of the used pixels that fall on the reference's matching it after the motion: implausible
   double max_depth_diff = 0.07;  ///< a pixel matches when its depth differs by at most this [m] (OpenCV's maxDepthDiff)
   double min_depth = 0.1;        ///< pixels nearer than this are not used [m]
   double max_depth = 4.0;        ///< pixels farther than this are not used [m]
@@ -84,7 +89,11 @@ struct OdometrySettings {
 struct OdometryDiagnostics {
   double valid_fraction = 0.0;   ///< of the image's pixels, those used (depth in range, not masked)
   double masked_fraction = 0.0;  ///< of the image's pixels, those the mask left out
-  double inlier_fraction = 0.0;  ///< of the used pixels, those matching the reference within max_depth_diff
+  /// Of the image's pixels, those used that fall, after the motion, on a
+  /// pixel the reference used (in view, not masked there): the overlap.
+  /// Below min_overlap_fraction the step is implausible.
+  double overlap_fraction = 0.0;
+  double inlier_fraction = 0.0;  ///< of the overlap, the pixels matching the reference within max_depth_diff
   double residual = 0.0;         ///< RMS depth difference of the matching pixels [m]
   double translation = 0.0;      ///< the step's motion from the previous pose [m] (as found, even when rejected)
   double rotation = 0.0;         ///< the step's rotation from the previous pose [deg]
@@ -149,7 +158,7 @@ class Odometry {
  * \brief A step's outcome as a pose source's answer (ofv::FramePose): the
  *        pose, ok for Ok and FirstFrame, source `odometry`, the status's word
  *        and the diagnostics (valid_fraction, masked_fraction,
- *        inlier_fraction, residual_m, translation_m, rotation_deg, keyframe, ms).
+ *        overlap_fraction, inlier_fraction, residual_m, translation_m, rotation_deg, keyframe, ms).
  */
 [[nodiscard]] FramePose frame_pose(const OdometryResult& result);
 
