@@ -67,9 +67,8 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   // never joins through a supervoxel that mixes it with the object.
   const Eigen::Isometry3d cMw = previous.wMc.inverse();
   const CameraIntrinsics& k = previous.intrinsics;
-  std::vector<int> hidden_before(n, 0);  // every hidden voxel
-  std::vector<int> seen_before(n, 0);    // voxels the previous frame showed where they are
-  std::vector<int> revealed(n, 0);       // those that are the object's
+  std::vector<int> seen_before(n, 0);  // voxels the previous frame showed where they are
+  std::vector<int> revealed(n, 0);     // voxels the object hid from it
   std::vector<char> voxel_revealed_here(r.voxels.size(), 0);
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
@@ -84,7 +83,6 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
     if (!(std::isfinite(d) && d > 0.0f)) continue;
     if (std::abs(static_cast<double>(d) - z) <= t.max_motion) ++seen_before[owner];
     if (!(static_cast<double>(d) < z - t.max_motion)) continue;
-    ++hidden_before[owner];
     const Eigen::Vector3f hider =
         (previous.wMc * Eigen::Vector3d((u - k.cx) * d / k.fx, (v - k.cy) * d / k.fy, d)).cast<float>();
     const Eigen::Vector3f c = chroma(sv.colours[i]);
@@ -98,17 +96,16 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   // A supervoxel joins when its revealed voxels and those near the memory
   // make min_near_fraction of it; the revealed voxels of one that does not
   // yet (revealed a strip at a time) are remembered, so that it joins once
-  // enough of it is. One that continues a surface of its colour seen before
-  // and not the object's (a distractor whose side the object hid) could be
-  // either's: it stays out.
+  // enough of it is. Ambiguous, and left out: one joined, through
+  // neighbours of one chromaticity that are not the object's, to a surface
+  // of that colour the previous frame showed (most of its voxels) that is
+  // not the object's (none near the memory): a distractor whose side the
+  // object hid could be either's.
   std::vector<std::vector<int>> neighbours(n);
   for (const auto& [a, b] : r.adjacency) {
     neighbours[static_cast<std::size_t>(a)].push_back(b);
     neighbours[static_cast<std::size_t>(b)].push_back(a);
   }
-  // Ambiguous: surface joined, through neighbours of one chromaticity that
-  // are not the object's, to a surface of that colour the previous frame
-  // showed (most of its voxels) that is not the object's (none near the memory).
   const auto alike = [&](std::size_t x, std::size_t y) {
     return max_chroma <= 0.0f ||
            (chroma(r.supervoxels[x].colour) - chroma(r.supervoxels[y].colour)).norm() <= max_chroma;
