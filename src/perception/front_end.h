@@ -131,7 +131,7 @@ struct Perception::Impl {
   detail::PointGrid seen_grid;                 // the frame's object voxels (remember())
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
   bool incomplete = false;  // the first frame showed an occluder cutting the object (behind_occluders())
-  RgbdFrame previous;  // the previous frame's depth, pose and intrinsics (no colour): revealed()
+  RgbdFrame previous;  // the previous frame's depth, pose and intrinsics (no colour), with grow_revealed: grow_revealed()
   std::optional<Eigen::Vector4d> plane;  // dominant (support) plane found in the first frame
   Eigen::Vector3f plane_chroma = Eigen::Vector3f::Zero();  // its mean chromaticity
 

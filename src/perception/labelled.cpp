@@ -74,7 +74,6 @@ std::vector<char> Perception::Impl::labelled_object(const PerceptionResult& r) {
   std::vector<char> object(r.supervoxels.size(), 0);
   for (std::size_t i = 0; i < object.size(); ++i) object[i] = supervoxel_labels[i] == kPixelObject ? 1 : 0;
   voxel_matched.assign(r.voxels.size(), 1);
-  voxel_revealed.assign(r.voxels.size(), 0);
   return object;
 }
 

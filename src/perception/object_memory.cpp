@@ -48,7 +48,6 @@ std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
             ? 1
             : 0;
   }
-  voxel_revealed.assign(r.voxels.size(), 0);
   if (t.grow_revealed) grow_revealed(r, near, object);
   return object;
 }

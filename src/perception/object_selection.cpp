@@ -327,7 +327,6 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
     if (object[ub] && !object[ua] && off_plane[ua]) foreign[ub].push_back(a);
   }
   voxel_matched.resize(r.voxels.size());
-  voxel_revealed.assign(r.voxels.size(), 0);
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     const Eigen::Vector3f c = chroma(sv.colours[i]);

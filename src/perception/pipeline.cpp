@@ -68,6 +68,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   // 3. The object: selected in the first frame, tracked afterwards; then remembered.
   stage = std::chrono::steady_clock::now();
   std::string why;
+  voxel_revealed.assign(r.voxels.size(), 0);  // only track() finds revealed surface
   const std::vector<char> object = labelled ? labelled_object(r) : initialised ? track(r) : select(frame, r, why);
   set_status(r, object, why);
   if (r.status != TrackingStatus::Lost) {
@@ -82,10 +83,11 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
     centroid = r.centroid;
   }
   r.timings.classify = ms_since(stage);
-  // What this frame could see, for the next one's revealed surface.
-  previous.depth.assign(frame.depth.begin(), frame.depth.end());
-  previous.intrinsics = frame.intrinsics;
-  previous.wMc = frame.wMc;
+  if (settings.tracking.grow_revealed) {  // what this frame could see, for the next one's revealed surface
+    previous.depth.assign(frame.depth.begin(), frame.depth.end());
+    previous.intrinsics = frame.intrinsics;
+    previous.wMc = frame.wMc;
+  }
   r.timings.total = ms_since(start);
   return r;
 }
