@@ -100,6 +100,7 @@ struct Perception::Impl {
   // never become object and cannot pull their neighbours in next frame.
   std::vector<char> voxel_matched;
   std::vector<char> voxel_revealed;  // revealed object surface (grow_revealed()), remembered
+  detail::PointGrid voxel_grid;      // grow_revealed(): the frame's voxels, for which supervoxels touch
   // object_motion(): the frame's object voxels (hashed), normals and
   // chromaticities, and the voxels on the object's own outline with the
   // outline's outward normal, of this frame and of the previous one.

@@ -92,44 +92,70 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
       ++revealed[owner];
     }
   }
+  if (std::none_of(revealed.begin(), revealed.end(), [](int c) { return c > 0; })) return;
   // A supervoxel joins when its revealed voxels and those near the memory
   // make min_near_fraction of it; the revealed voxels of one that does not
   // yet (revealed a strip at a time) are remembered, so that it joins once
-  // enough of it is. Ambiguous, and left out: one joined, through
+  // enough of it is. Ambiguous, and left out: one linked, through
   // neighbours of one chromaticity that are not the object's, to a surface
   // of that colour the previous frame showed (most of its voxels) that is
   // not the object's (none near the memory): a distractor whose side the
-  // object hid could be either's.
-  std::vector<std::vector<int>> neighbours(n);
-  for (const auto& [a, b] : r.adjacency) {
-    neighbours[static_cast<std::size_t>(a)].push_back(b);
-    neighbours[static_cast<std::size_t>(b)].push_back(a);
+  // object hid could be either's. Neighbours: two voxels within R_adj
+  // (eq. 1's distance, here between voxels, not centroids: a strip revealed
+  // along a distractor's edge, seen grazing, is a broken line of voxels
+  // whose centroids lie farther than R_adj from the part it continues).
+  const auto r_adj = static_cast<float>(settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution);
+  voxel_grid.build(r.voxels, r_adj);
+  std::vector<int> first(n + 1, 0);  // the voxels of supervoxel j: members[first[j] .. first[j + 1])
+  for (const int owner : r.voxel_owner) ++first[static_cast<std::size_t>(owner) + 1];
+  for (std::size_t j = 0; j < n; ++j) first[j + 1] += first[j];
+  std::vector<int> members(r.voxels.size());
+  {
+    std::vector<int> next(first.begin(), first.end() - 1);
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      members[static_cast<std::size_t>(next[static_cast<std::size_t>(r.voxel_owner[i])]++)] = static_cast<int>(i);
+    }
   }
   const auto alike = [&](std::size_t x, std::size_t y) {
     return max_chroma <= 0.0f ||
            (chroma(r.supervoxels[x].colour) - chroma(r.supervoxels[y].colour)).norm() <= max_chroma;
   };
-  std::vector<char> ambiguous(n, 0);
+  const auto candidate = [&](std::size_t j) { return !object[j] && !on_plane(r.supervoxels[j]); };
+  const auto seen_not_object = [&](std::size_t j) {
+    return 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0;
+  };
+  // From each revealed supervoxel, its component (of candidates linked to
+  // alike neighbours); a component is searched once.
+  std::vector<int> component(n, -1);
+  std::vector<char> component_ambiguous;
   std::vector<std::size_t> open;
   for (std::size_t j = 0; j < n; ++j) {
-    if (!object[j] && 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0 && !on_plane(r.supervoxels[j])) {
-      open.push_back(j);
-    }
-  }
-  while (!open.empty()) {
-    const std::size_t x = open.back();
-    open.pop_back();
-    for (const int other : neighbours[x]) {
-      const auto y = static_cast<std::size_t>(other);
-      if (!ambiguous[y] && !object[y] && !on_plane(r.supervoxels[y]) && alike(x, y)) {
-        ambiguous[y] = 1;
-        open.push_back(y);
+    if (revealed[j] == 0 || component[j] >= 0 || !candidate(j)) continue;
+    const int id = static_cast<int>(component_ambiguous.size());
+    bool ambiguous = false;
+    component[j] = id;
+    open.assign(1, j);
+    while (!open.empty()) {
+      const std::size_t x = open.back();
+      open.pop_back();
+      ambiguous = ambiguous || seen_not_object(x);
+      for (int m = first[x]; m < first[x + 1]; ++m) {
+        const Eigen::Vector3f& p = r.voxels[static_cast<std::size_t>(members[static_cast<std::size_t>(m)])];
+        voxel_grid.for_each_near(p, [&](int other) {
+          const auto y = static_cast<std::size_t>(r.voxel_owner[static_cast<std::size_t>(other)]);
+          if (component[y] < 0 && candidate(y) && alike(x, y) &&
+              (r.voxels[static_cast<std::size_t>(other)] - p).squaredNorm() <= r_adj * r_adj) {
+            component[y] = id;
+            open.push_back(y);
+          }
+        });
       }
     }
+    component_ambiguous.push_back(ambiguous ? 1 : 0);
   }
   std::vector<char> reached(n, 0);
   for (std::size_t j = 0; j < n; ++j) {
-    if (revealed[j] == 0 || on_plane(r.supervoxels[j]) || ambiguous[j]) continue;
+    if (revealed[j] == 0 || !candidate(j) || component_ambiguous[static_cast<std::size_t>(component[j])]) continue;
     reached[j] = 1;
     object[j] = static_cast<double>(revealed[j] + near[j]) >=
                 t.min_near_fraction * static_cast<double>(r.supervoxels[j].voxel_count);

@@ -405,6 +405,36 @@ TEST(Perception, SurfaceItsOwnFrontHidJoinsTheObjectWhenRevealed) {
   }
 }
 
+TEST(Perception, DistractorOfTheObjectsColourStaysOutAsTheObjectRevealsIt) {
+  // A panel of the case's colour stands 8 cm behind it and sticks out 15 cm
+  // to its left, where the first camera sees it. As the camera rises, the
+  // part the case hid comes into view behind it as grow_revealed's fold
+  // would: it is the distractor's, seen before as not the object, and
+  // stays out however much of it appears.
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(test::make_box({-0.1, 0.08, 0.045}, {0.30, 0.015, 0.09}, {40, 60, 200}, test::kOther));
+  perception::PerceptionSettings settings;
+  settings.tracking.grow_revealed = true;
+  perception::Perception perception{settings};
+  for (int k = 0; k <= 20; ++k) {
+    const Eigen::Isometry3d wMc = test::look_at(kCaseCentre + Eigen::Vector3d(0.0, -0.45, 0.22 + 0.0265 * k), kCaseCentre);
+    Frame f = render(scene, wMc, 320);
+    test::add_depth_noise(f.frame, 5u + static_cast<unsigned>(k));
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << r.message;
+    int panel = 0;
+    int taken = 0;
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      if (r.voxels[i].y() < 0.06f || r.voxels[i].z() < 0.005f) continue;  // the panel, not the case or the table
+      ++panel;
+      taken += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
+    }
+    if (std::getenv("OFV_DBG") && k >= 4 && k <= 5) for (std::size_t i = 0; i < r.voxels.size(); ++i) if (r.voxels[i].y() > 0.06f && r.voxels[i].z() > 0.085f) fprintf(stderr, "k%d x=%.3f y=%.3f z=%.3f sv=%d lab=%d\n", k, r.voxels[i].x(), r.voxels[i].y(), r.voxels[i].z(), r.voxel_owner[i], (int)r.supervoxels[(std::size_t)r.voxel_owner[i]].label);
+    ASSERT_GT(panel, 50) << "frame " << k << ": the camera does not see the panel";
+    EXPECT_LE(taken, panel / 50) << "frame " << k << ": " << taken << " of the panel's " << panel << " voxels are the object's";
+  }
+}
+
 /// Largest distance of the problem's hidden vertices (its last
 /// counts.hidden_vertices columns) from the case, the box of `centre` [m].
 double hidden_vertices_off_case(const perception::PerceptionResult& r, const Eigen::Vector3d& centre) {
