@@ -56,18 +56,35 @@ enum class Sight {
   NoDepth,  ///< its pixel has no depth (a drop-out, or a sensor's shadow next to an occluding edge)
 };
 
+/// Where world point p falls in a frame: its pixel, its depth in that
+/// camera [m] and the depth the frame measured at the pixel (not finite, or
+/// 0: none). nullopt behind the camera or out of the image.
+struct Look {
+  int u = 0;
+  int v = 0;
+  double z = 0.0;
+  float observed = 0.0f;
+  [[nodiscard]] bool measured() const { return std::isfinite(observed) && observed > 0.0f; }
+};
+
+inline std::optional<Look> look(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p) {
+  Look l;
+  const auto px = project(frame, cMw, p, &l.z);
+  if (!px) return std::nullopt;
+  l.u = static_cast<int>(std::lround(px->x()));
+  l.v = static_cast<int>(std::lround(px->y()));
+  const CameraIntrinsics& k = frame.intrinsics;
+  if (l.u < 0 || l.v < 0 || l.u >= k.width || l.v >= k.height) return std::nullopt;
+  l.observed = frame.depth[frame.index(l.u, l.v)];
+  return l;
+}
+
 inline Sight sight(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
                    double tolerance) {
-  double z = 0.0;
-  const auto px = project(frame, cMw, p, &z);
-  if (!px) return Sight::Hidden;
-  const int u = static_cast<int>(std::lround(px->x()));
-  const int v = static_cast<int>(std::lround(px->y()));
-  const CameraIntrinsics& k = frame.intrinsics;
-  if (u < 0 || v < 0 || u >= k.width || v >= k.height) return Sight::Hidden;
-  const float observed = frame.depth[frame.index(u, v)];
-  if (!(std::isfinite(observed) && observed > 0.0f)) return Sight::NoDepth;
-  return static_cast<double>(observed) < z - tolerance ? Sight::Hidden : Sight::Shown;
+  const auto l = look(frame, cMw, p);
+  if (!l) return Sight::Hidden;
+  if (!l->measured()) return Sight::NoDepth;
+  return static_cast<double>(l->observed) < l->z - tolerance ? Sight::Hidden : Sight::Shown;
 }
 
 }  // namespace detail

@@ -72,18 +72,13 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     if (object[owner] || plane_voxel(r.voxels[i], sv.colours[i])) continue;
-    double z = 0.0;
-    const auto px = detail::project(previous, cMw, r.voxels[i].cast<double>(), &z);
-    if (!px) continue;
-    const int u = static_cast<int>(std::lround(px->x()));
-    const int v = static_cast<int>(std::lround(px->y()));
-    if (u < 0 || v < 0 || u >= k.width || v >= k.height) continue;
-    const float d = previous.depth[previous.index(u, v)];
-    if (!(std::isfinite(d) && d > 0.0f)) continue;
-    if (std::abs(static_cast<double>(d) - z) <= t.max_motion) ++seen_before[owner];
-    if (!(static_cast<double>(d) < z - t.max_motion)) continue;
+    const auto l = detail::look(previous, cMw, r.voxels[i].cast<double>());
+    if (!l || !l->measured()) continue;
+    const double d = l->observed;
+    if (std::abs(d - l->z) <= t.max_motion) ++seen_before[owner];
+    if (!(d < l->z - t.max_motion)) continue;
     const Eigen::Vector3f hider =
-        (previous.wMc * Eigen::Vector3d((u - k.cx) * d / k.fx, (v - k.cy) * d / k.fy, d)).cast<float>();
+        (previous.wMc * Eigen::Vector3d((l->u - k.cx) * d / k.fx, (l->v - k.cy) * d / k.fy, d)).cast<float>();
     const Eigen::Vector3f c = chroma(sv.colours[i]);
     if (grid.any_within(hider, res, [&](int j) {
           return max_chroma <= 0.0f || (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
