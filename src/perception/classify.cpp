@@ -150,9 +150,33 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
               object_grid.any_within(r.voxels[i], static_cast<float>(settings.contact_distance), [](int) { return true; }));
   }
 
+  // holder_body: from the interacting supervoxels on through what touches
+  // them and is of their colour (in the sphere, not the support plane).
+  // Classes::Labels knows the holder's body from its labels.
+  const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
+  std::vector<char> interacting = touches;
+  std::vector<std::size_t> open;
+  for (std::size_t i = 0; i < n && settings.holder_body && !labelled; ++i) {
+    if (interacting[i]) open.push_back(i);
+  }
+  if (!open.empty()) {
+    contacts.build(r, settings.contact_distance);
+    while (!open.empty()) {
+      const std::size_t x = open.back();
+      open.pop_back();
+      contacts.for_each(x, [&](std::size_t y) {
+        const SupervoxelInfo& s = r.supervoxels[y];
+        if (!interacting[y] && !object[y] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere &&
+            detail::alike(r.supervoxels[x].colour, s.colour, settings.tracking.max_chroma_distance)) {
+          interacting[y] = 1;
+          open.push_back(y);
+        }
+      });
+    }
+  }
+
   // Labels (paper II-B) and the estimator's input. Classes::Labels: the
   // frame's labels of each supervoxel (supervoxel_labels) for the bodies.
-  const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
   const std::vector<std::uint16_t>& truth = supervoxel_labels;
   const auto is_body = [](std::uint16_t label) { return label == kPixelInteracting || label >= kPixelOccluder0; };
   std::vector<int> vertices;
@@ -178,7 +202,7 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
       }
     } else if (!settings.support_plane_occludes && (labelled ? truth[i] == kPixelSupport : on_plane(s))) {
       s.label = SupervoxelClass::Background;
-    } else if (r.obb.contains(s.centroid) && touches[i]) {
+    } else if (interacting[i]) {
       s.label = SupervoxelClass::Interacting;
       ++r.counts.interacting;
     } else if ((s.centroid - c).norm() < settings.r_sphere) {

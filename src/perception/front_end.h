@@ -35,6 +35,11 @@ inline Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) {
   return rgb / std::max(rgb.sum(), 1.0f);
 }
 
+/// Two colours alike: their chromaticities within max_chroma (<= 0: any).
+inline bool alike(const Eigen::Vector3f& a, const Eigen::Vector3f& b, double max_chroma) {
+  return max_chroma <= 0.0 || static_cast<double>((chroma(a) - chroma(b)).norm()) <= max_chroma;
+}
+
 /// Pixel of world point p in the frame's camera; nullopt behind the camera.
 inline std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eigen::Isometry3d& cMw,
                                               const Eigen::Vector3d& p, double* depth = nullptr) {
@@ -87,6 +92,51 @@ inline Sight sight(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const E
   return static_cast<double>(l->observed) < l->z - tolerance ? Sight::Hidden : Sight::Shown;
 }
 
+/// The frame's voxels grouped by supervoxel and hashed: which supervoxels
+/// come within a distance of one another, voxel to voxel (eq. 1's adjacency
+/// measures between centroids, which misses a broken strip of voxels and a
+/// long body touching another at one end).
+class VoxelContacts {
+ public:
+  void build(const PerceptionResult& r, double radius) {
+    voxels_ = &r.voxels;
+    owners_ = &r.voxel_owner;
+    radius2_ = static_cast<float>(radius * radius);
+    grid_.build(r.voxels, radius);
+    first_.assign(r.supervoxels.size() + 1, 0);
+    for (const int owner : r.voxel_owner) ++first_[static_cast<std::size_t>(owner) + 1];
+    for (std::size_t j = 0; j + 1 < first_.size(); ++j) first_[j + 1] += first_[j];
+    members_.resize(r.voxels.size());
+    next_.assign(first_.begin(), first_.end() - 1);
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      members_[static_cast<std::size_t>(next_[static_cast<std::size_t>(r.voxel_owner[i])]++)] = static_cast<int>(i);
+    }
+  }
+
+  /// Calls f(y) for every supervoxel y with a voxel within the distance of
+  /// one of x's (y repeats, once per such pair of voxels; x itself too).
+  template <typename F>
+  void for_each(std::size_t x, F&& f) const {
+    for (int m = first_[x]; m < first_[x + 1]; ++m) {
+      const Eigen::Vector3f& p = (*voxels_)[static_cast<std::size_t>(members_[static_cast<std::size_t>(m)])];
+      grid_.for_each_near(p, [&](int j) {
+        if (((*voxels_)[static_cast<std::size_t>(j)] - p).squaredNorm() <= radius2_) {
+          f(static_cast<std::size_t>((*owners_)[static_cast<std::size_t>(j)]));
+        }
+      });
+    }
+  }
+
+ private:
+  const std::vector<Eigen::Vector3f>* voxels_ = nullptr;
+  const std::vector<int>* owners_ = nullptr;
+  float radius2_ = 0.0f;
+  PointGrid grid_;
+  std::vector<int> first_;    // the voxels of supervoxel j: members_[first_[j] .. first_[j + 1])
+  std::vector<int> members_;
+  std::vector<int> next_;     // build()'s fill positions
+};
+
 }  // namespace detail
 
 struct Perception::Impl {
@@ -117,7 +167,7 @@ struct Perception::Impl {
   // never become object and cannot pull their neighbours in next frame.
   std::vector<char> voxel_matched;
   std::vector<char> voxel_revealed;  // revealed object surface (grow_revealed()), remembered
-  detail::PointGrid voxel_grid;      // grow_revealed(): the frame's voxels, for which supervoxels touch
+  detail::VoxelContacts contacts;    // grow_revealed(), classify(): which supervoxels come near one another
   // object_motion(): the frame's object voxels (hashed), normals and
   // chromaticities, and the voxels on the object's own outline with the
   // outline's outward normal, of this frame and of the previous one.

@@ -99,21 +99,9 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   // (eq. 1's distance, here between voxels, not centroids: a strip revealed
   // along a distractor's edge, seen grazing, is a broken line of voxels
   // whose centroids lie farther than R_adj from the part it continues).
-  const auto r_adj = static_cast<float>(settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution);
-  voxel_grid.build(r.voxels, r_adj);
-  std::vector<int> first(n + 1, 0);  // the voxels of supervoxel j: members[first[j] .. first[j + 1])
-  for (const int owner : r.voxel_owner) ++first[static_cast<std::size_t>(owner) + 1];
-  for (std::size_t j = 0; j < n; ++j) first[j + 1] += first[j];
-  std::vector<int> members(r.voxels.size());
-  {
-    std::vector<int> next(first.begin(), first.end() - 1);
-    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-      members[static_cast<std::size_t>(next[static_cast<std::size_t>(r.voxel_owner[i])]++)] = static_cast<int>(i);
-    }
-  }
+  contacts.build(r, settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution);
   const auto alike = [&](std::size_t x, std::size_t y) {
-    return max_chroma <= 0.0f ||
-           (chroma(r.supervoxels[x].colour) - chroma(r.supervoxels[y].colour)).norm() <= max_chroma;
+    return detail::alike(r.supervoxels[x].colour, r.supervoxels[y].colour, t.max_chroma_distance);
   };
   const auto candidate = [&](std::size_t j) { return !object[j] && !on_plane(r.supervoxels[j]); };
   const auto seen_not_object = [&](std::size_t j) {
@@ -134,17 +122,12 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
       const std::size_t x = open.back();
       open.pop_back();
       ambiguous = ambiguous || seen_not_object(x);
-      for (int m = first[x]; m < first[x + 1]; ++m) {
-        const Eigen::Vector3f& p = r.voxels[static_cast<std::size_t>(members[static_cast<std::size_t>(m)])];
-        voxel_grid.for_each_near(p, [&](int other) {
-          const auto y = static_cast<std::size_t>(r.voxel_owner[static_cast<std::size_t>(other)]);
-          if (component[y] < 0 && candidate(y) && alike(x, y) &&
-              (r.voxels[static_cast<std::size_t>(other)] - p).squaredNorm() <= r_adj * r_adj) {
-            component[y] = id;
-            open.push_back(y);
-          }
-        });
-      }
+      contacts.for_each(x, [&](std::size_t y) {
+        if (component[y] < 0 && candidate(y) && alike(x, y)) {
+          component[y] = id;
+          open.push_back(y);
+        }
+      });
     }
     component_ambiguous.push_back(ambiguous ? 1 : 0);
   }

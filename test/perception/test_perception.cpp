@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <type_traits>
 #include <cmath>
 #include <limits>
@@ -179,6 +180,49 @@ TEST_P(HandHolding, HandIsInteractingNotObject) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Perception, HandHolding, testing::Values(640, 320));
+
+TEST(Perception, HolderBodyBeyondTheBoxIsInteractingWithHolderBody) {
+  // A hand grips the case's right edge; its forearm goes on to the right and
+  // back, beyond the augmented OBB, and touches a green post there. With
+  // holder_body the forearm is interacting, as the hand in contact is; the
+  // post, of another colour, stays an occluder. Without (the paper's
+  // classes) the forearm outside the box is an occluder.
+  const auto classes = [](bool holder_body) {
+    perception::PerceptionSettings settings;
+    settings.holder_body = holder_body;
+    perception::Perception perception{settings};
+    const Eigen::Isometry3d wMc = test::front_camera();
+    EXPECT_EQ(perception.process(render(test::table_and_case(), wMc).frame).status,
+              perception::TrackingStatus::Initialised);
+    perception::PerceptionResult r;
+    Frame f;
+    for (int step = 5; step >= 0; --step) {
+      const double gap = 0.01 * step;
+      test::SyntheticScene scene = test::table_and_case();
+      scene.shapes.push_back(holding_hand(gap));
+      scene.shapes.push_back(
+          test::make_capsule({0.115 + gap, -0.005, 0.075}, {0.21 + gap, 0.05, 0.10}, 0.025, kSkin, kHand));
+      scene.shapes.push_back(test::make_box({0.245 + gap, 0.05, 0.10}, {0.03, 0.03, 0.2}, {40, 180, 60}, test::kOther));
+      f = render(scene, wMc);
+      r = perception.process(f.frame);
+      EXPECT_EQ(r.status, perception::TrackingStatus::Tracking) << "step " << step << ": " << r.message;
+    }
+    const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
+    return std::array<int, 4>{test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Interacting),
+                              test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Occluder),
+                              test::count_truth_as(r, truth, test::kOther, perception::SupervoxelClass::Interacting),
+                              test::count_truth_as(r, truth, test::kOther, perception::SupervoxelClass::Occluder)};
+  };
+  const auto body = classes(true);
+  const auto paper = classes(false);
+  EXPECT_GE(body[0], 20);  // measured: 27 (of them 6 in the box, as without)
+  EXPECT_EQ(body[1], 0);
+  EXPECT_EQ(body[2], 0);
+  EXPECT_GE(body[3], 10);  // 21
+  EXPECT_GE(paper[1], 10);  // 21
+  EXPECT_LT(paper[0], body[0]);
+  EXPECT_GE(paper[3], 10);
+}
 
 TEST(Perception, ArmInFrontIsAnOccluderAndMovesTheView) {
   perception::Perception perception{perception::PerceptionSettings{}};

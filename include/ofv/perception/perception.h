@@ -169,6 +169,14 @@ struct PerceptionSettings {
   /// from the object (in the hollow of a bent cloth, over its fold) is an
   /// occluder (README, "What perception costs").
   double contact_distance = 0.015;
+  /// The holder's body beyond the augmented OBB is interacting too: a
+  /// supervoxel in the sphere, not of the support plane, in contact
+  /// (contact_distance, voxel to voxel) with an interacting one and of its
+  /// chromaticity (TrackingSettings::max_chroma_distance), in turn. The
+  /// wrist and arm of a hand holding the object move with it; the paper's
+  /// classes (false) make them occluders, which send the camera away from
+  /// views they would not block for long.
+  bool holder_body = false;
   /// The paper's classification makes every non-object supervoxel inside
   /// the sphere an occluder (or, inside the OBB, interacting), the table the
   /// object stands on included. false: supervoxels of the support plane
@@ -327,7 +335,7 @@ void validate(const PerceptionSettings& settings);
                                                      PerceptionSettings base = {});
 
 /// \brief The front end's settings a user sets by name (`--set`, scenario
-///        files, grids): supervoxels, beyond_view, behind_occluders, grow_revealed.
+///        files, grids): supervoxels, beyond_view, behind_occluders, grow_revealed, holder_body.
 [[nodiscard]] const SettingsTable<PerceptionSettings>& perception_settings_table();
 
 /**
