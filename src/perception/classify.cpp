@@ -105,6 +105,58 @@ void Perception::Impl::hidden_vertices(ViewProblem& p, std::size_t seen) const {
   }
 }
 
+void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<char>& object,
+                                    const Eigen::Vector3d& c, std::vector<char>& interacting) {
+  // The holder is what is interacting when the object is selected. Later
+  // frames find it again near where it was (within max_motion, moved with
+  // the object); from there its body grows through supervoxels in contact
+  // (contact_distance, voxel to voxel) and of its colour, in the sphere,
+  // not of the support plane. A hand that comes to touch the object later
+  // is interacting where it touches, by the paper's rule, and an occluder
+  // beyond: it may stand in front of the object (a hand over a cloth's
+  // fold), which a holder seldom does.
+  const std::size_t n = r.supervoxels.size();
+  const bool first = r.status == TrackingStatus::Initialised;
+  if (first) holder.clear();
+  const auto radius = static_cast<float>(settings.tracking.max_motion);
+  holder_grid.build(holder, radius);
+  std::vector<char> body(n, 0);
+  std::vector<std::size_t> open;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    if (body[owner] || !interacting[owner]) continue;
+    if (first || holder_grid.any_within(r.voxels[i], radius, [](int) { return true; })) {
+      body[owner] = 1;
+      open.push_back(owner);
+    }
+  }
+  if (!open.empty()) contacts.build(r, settings.contact_distance);
+  while (!open.empty()) {
+    const std::size_t x = open.back();
+    open.pop_back();
+    contacts.for_each(x, [&](std::size_t y) {
+      const SupervoxelInfo& s = r.supervoxels[y];
+      if (!body[y] && !object[y] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere &&
+          detail::alike(r.supervoxels[x].colour, s.colour, settings.tracking.max_chroma_distance)) {
+        body[y] = 1;
+        interacting[y] = 1;
+        open.push_back(y);
+      }
+    });
+  }
+  // Remembered as last seen, for as long as the object's hidden part is.
+  std::vector<Eigen::Vector3f> seen;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (body[static_cast<std::size_t>(r.voxel_owner[i])]) seen.push_back(r.voxels[i]);
+  }
+  if (!seen.empty()) {
+    holder.swap(seen);
+    holder_age = 0;
+  } else if (++holder_age > settings.tracking.occlusion_memory_frames) {
+    holder.clear();
+  }
+}
+
 void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object) {
   const std::size_t n = r.supervoxels.size();
   // The object's voxel cloud: what is seen of it, plus the remembered voxels
@@ -150,30 +202,9 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
               object_grid.any_within(r.voxels[i], static_cast<float>(settings.contact_distance), [](int) { return true; }));
   }
 
-  // holder_body: from the interacting supervoxels on through what touches
-  // them and is of their colour (in the sphere, not the support plane).
-  // Classes::Labels knows the holder's body from its labels.
   const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
   std::vector<char> interacting = touches;
-  std::vector<std::size_t> open;
-  for (std::size_t i = 0; i < n && settings.holder_body && !labelled; ++i) {
-    if (interacting[i]) open.push_back(i);
-  }
-  if (!open.empty()) {
-    contacts.build(r, settings.contact_distance);
-    while (!open.empty()) {
-      const std::size_t x = open.back();
-      open.pop_back();
-      contacts.for_each(x, [&](std::size_t y) {
-        const SupervoxelInfo& s = r.supervoxels[y];
-        if (!interacting[y] && !object[y] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere &&
-            detail::alike(r.supervoxels[x].colour, s.colour, settings.tracking.max_chroma_distance)) {
-          interacting[y] = 1;
-          open.push_back(y);
-        }
-      });
-    }
-  }
+  if (settings.holder_body && !labelled) grow_holder(r, object, c, interacting);  // labels know the holder
 
   // Labels (paper II-B) and the estimator's input. Classes::Labels: the
   // frame's labels of each supervoxel (supervoxel_labels) for the bodies.

@@ -193,6 +193,9 @@ struct Perception::Impl {
   bool initialised = false;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3f> memory;  // object voxels: seen now, or hidden behind something
+  std::vector<Eigen::Vector3f> holder;  // holder_body: the holder's voxels when last seen (grow_holder())
+  int holder_age = 0;                   // frames since the holder was last seen
+  detail::PointGrid holder_grid;
   std::vector<Eigen::Vector3f> memory_chroma;  // chromaticity of each memory voxel
   std::vector<int> memory_age;                 // frames since the voxel was last seen
   std::vector<Eigen::Vector3f> memory_normal;  // its supervoxel's normal then (0: none)
@@ -266,6 +269,9 @@ struct Perception::Impl {
   void behind_occluders(const RgbdFrame& frame, PerceptionResult& r);
   /// classify.cpp: C, axes, OBB, labels and r.problem.
   void classify(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object);
+  /// holder_body: marks interacting the holder's body beyond the box (PerceptionSettings::holder_body).
+  void grow_holder(const PerceptionResult& r, const std::vector<char>& object, const Eigen::Vector3d& c,
+                   std::vector<char>& interacting);
   /// classify.cpp: occluder points beyond the image border, where the
   /// occluders the border cuts continue (PerceptionSettings::beyond_view),
   /// appended to r.problem.occluders.

@@ -154,6 +154,7 @@ PerceptionResult Perception::process(const RgbdFrame& frame) { return impl_->pro
 void Perception::reset() {
   impl_->initialised = false;
   impl_->memory.clear();
+  impl_->holder.clear();
   impl_->memory_chroma.clear();
   impl_->memory_age.clear();
   impl_->memory_normal.clear();
