@@ -108,8 +108,8 @@ void Perception::Impl::hidden_vertices(ViewProblem& p, std::size_t seen) const {
 void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<char>& object,
                                     const Eigen::Vector3d& c, std::vector<char>& interacting) {
   // The holder is what is interacting when the object is selected. Later
-  // frames find it again near where it was (within max_motion, moved with
-  // the object); from there its body grows through supervoxels in contact
+  // frames find it again inside the box near where it was (within
+  // max_motion, moved with the object); from there its body grows through supervoxels in contact
   // (contact_distance, voxel to voxel) and of its colour, in the sphere,
   // not of the support plane. A hand that comes to touch the object later
   // is interacting where it touches, by the paper's rule, and an occluder
@@ -124,9 +124,15 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
   std::vector<std::size_t> open;
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
-    if (body[owner] || !interacting[owner]) continue;
-    if (first || holder_grid.any_within(r.voxels[i], radius, [](int) { return true; })) {
+    const SupervoxelInfo& s = r.supervoxels[owner];
+    if (body[owner] || object[owner] || on_plane(s)) continue;
+    // Later frames: in the box, in contact or not (a hand gripping the
+    // case's edge seen grazing may lie farther than contact_distance).
+    if (first ? interacting[owner] != 0
+              : (interacting[owner] || r.obb.contains(s.centroid)) &&
+                    holder_grid.any_within(r.voxels[i], radius, [](int) { return true; })) {
       body[owner] = 1;
+      interacting[owner] = 1;
       open.push_back(owner);
     }
   }

@@ -115,15 +115,13 @@ struct TrackingSettings {
   /// hiding surface was the object (a remembered voxel of the voxel's
   /// chromaticity) counts as the object's. A supervoxel joins when those
   /// and the near voxels make min_near_fraction of it, never one on the
-  /// support plane nor one touching a surface of its colour seen before and
-  /// not the object's (a distractor whose side the object hid could be
-  /// either's); the counted voxels of one that does not yet are remembered,
-  /// so that it joins once enough of it is. Off by default: a distractor of
-  /// the object's colour standing behind it, seen beside it first, can
-  /// still join once more of it comes into view (docs/perception.md).
-  /// false: only what lies within max_motion of the remembered object (the
-  /// paper's assumption 2).
-  bool grow_revealed = false;
+  /// support plane nor one linked (voxels within R_adj) through surface of
+  /// its colour to a surface of that colour seen before and not the
+  /// object's (a distractor whose side the object hid could be either's);
+  /// the counted voxels of one that does not yet are remembered, so that it
+  /// joins once enough of it is. false: only what lies within max_motion of
+  /// the remembered object (the paper's assumption 2).
+  bool grow_revealed = true;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
   /// this distance, normal within 60 degrees) are never object: the table
@@ -169,14 +167,17 @@ struct PerceptionSettings {
   /// from the object (in the hollow of a bent cloth, over its fold) is an
   /// occluder (README, "What perception costs").
   double contact_distance = 0.015;
-  /// The holder's body beyond the augmented OBB is interacting too: a
-  /// supervoxel in the sphere, not of the support plane, in contact
-  /// (contact_distance, voxel to voxel) with an interacting one and of its
-  /// chromaticity (TrackingSettings::max_chroma_distance), in turn. The
-  /// wrist and arm of a hand holding the object move with it; the paper's
-  /// classes (false) make them occluders, which send the camera away from
-  /// views they would not block for long.
-  bool holder_body = false;
+  /// The holder's body beyond the augmented OBB is interacting too. The
+  /// holder is what is interacting when the object is selected; later
+  /// frames find it again within max_motion of where it was (moved with the
+  /// object), and its body grows from there through supervoxels in the
+  /// sphere, not of the support plane, in contact (contact_distance, voxel
+  /// to voxel) and of its chromaticity (TrackingSettings::max_chroma_distance).
+  /// The wrist and arm of a hand holding the object move with it; the
+  /// paper's classes (false) make them occluders, which send the camera
+  /// away from views they seldom block. A hand that comes to touch the
+  /// object later keeps the paper's classes (a hand over a cloth's fold).
+  bool holder_body = true;
   /// The paper's classification makes every non-object supervoxel inside
   /// the sphere an occluder (or, inside the OBB, interacting), the table the
   /// object stands on included. false: supervoxels of the support plane
