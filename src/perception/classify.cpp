@@ -109,12 +109,12 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
                                     const Eigen::Vector3d& c, std::vector<char>& interacting) {
   // The holder is what is interacting when the object is selected. Later
   // frames find it again inside the box near where it was (within
-  // max_motion, moved with the object); from there its body grows through supervoxels in contact
-  // (contact_distance, voxel to voxel) and of its colour, in the sphere,
-  // not of the support plane. A hand that comes to touch the object later
-  // is interacting where it touches, by the paper's rule, and an occluder
-  // beyond: it may stand in front of the object (a hand over a cloth's
-  // fold), which a holder seldom does.
+  // max_motion, moved with the object); from there its body grows through
+  // supervoxels in contact (contact_distance, voxel to voxel) and of its
+  // colour, in the sphere, not of the support plane. A hand that comes to
+  // touch the object later is interacting where it touches, by the paper's
+  // rule, and an occluder beyond: it may stand in front of the object (a
+  // hand over a cloth's fold), which a holder seldom does.
   const std::size_t n = r.supervoxels.size();
   const bool first = r.status == TrackingStatus::Initialised;
   if (first) holder.clear();

@@ -155,6 +155,7 @@ void Perception::reset() {
   impl_->initialised = false;
   impl_->memory.clear();
   impl_->holder.clear();
+  impl_->holder_age = 0;
   impl_->memory_chroma.clear();
   impl_->memory_age.clear();
   impl_->memory_normal.clear();

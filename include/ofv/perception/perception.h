@@ -169,8 +169,9 @@ struct PerceptionSettings {
   double contact_distance = 0.015;
   /// The holder's body beyond the augmented OBB is interacting too. The
   /// holder is what is interacting when the object is selected; later
-  /// frames find it again within max_motion of where it was (moved with the
-  /// object), and its body grows from there through supervoxels in the
+  /// frames find it again inside the box within max_motion of where it was
+  /// (moved with the object), in contact or not, and its body grows from
+  /// there through supervoxels in the
   /// sphere, not of the support plane, in contact (contact_distance, voxel
   /// to voxel) and of its chromaticity (TrackingSettings::max_chroma_distance).
   /// The wrist and arm of a hand holding the object move with it; the
