@@ -136,14 +136,17 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
       open.push_back(owner);
     }
   }
-  if (!open.empty()) contacts.build(r, settings.contact_distance);
+  const auto candidate = [&](std::size_t j) {
+    const SupervoxelInfo& s = r.supervoxels[j];
+    return !object[j] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere;
+  };
+  if (!open.empty()) contacts.build(r, settings.contact_distance, candidate);
   while (!open.empty()) {
     const std::size_t x = open.back();
     open.pop_back();
     contacts.for_each(x, [&](std::size_t y) {
-      const SupervoxelInfo& s = r.supervoxels[y];
-      if (!body[y] && !object[y] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere &&
-          detail::alike(r.supervoxels[x].colour, s.colour, settings.tracking.max_chroma_distance)) {
+      if (!body[y] && detail::alike(r.supervoxels[x].colour, r.supervoxels[y].colour,
+                                    settings.tracking.max_chroma_distance)) {
         body[y] = 1;
         interacting[y] = 1;
         open.push_back(y);

@@ -98,43 +98,54 @@ inline Sight sight(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const E
 /// long body touching another at one end).
 class VoxelContacts {
  public:
-  void build(const PerceptionResult& r, double radius) {
-    voxels_ = &r.voxels;
-    owners_ = &r.voxel_owner;
+  /// Hashes the voxels of the supervoxels j with keep(j) (the only ones
+  /// for_each() visits and finds).
+  template <typename Keep>
+  void build(const PerceptionResult& r, double radius, Keep&& keep) {
     radius2_ = static_cast<float>(radius * radius);
-    grid_.build(r.voxels, radius);
+    points_.clear();
+    owners_.clear();
     first_.assign(r.supervoxels.size() + 1, 0);
-    for (const int owner : r.voxel_owner) ++first_[static_cast<std::size_t>(owner) + 1];
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+      if (keep(owner)) ++first_[owner + 1];
+    }
     for (std::size_t j = 0; j + 1 < first_.size(); ++j) first_[j + 1] += first_[j];
-    members_.resize(r.voxels.size());
+    points_.resize(static_cast<std::size_t>(first_.back()));
+    owners_.resize(points_.size());
     next_.assign(first_.begin(), first_.end() - 1);
     for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-      members_[static_cast<std::size_t>(next_[static_cast<std::size_t>(r.voxel_owner[i])]++)] = static_cast<int>(i);
+      const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+      if (!keep(owner)) continue;
+      const auto at = static_cast<std::size_t>(next_[owner]++);
+      points_[at] = r.voxels[i];  // grouped by supervoxel: points_[first_[j] .. first_[j + 1])
+      owners_[at] = static_cast<int>(owner);
     }
+    grid_.build(points_, radius);
   }
 
-  /// Calls f(y) for every supervoxel y with a voxel within the distance of
-  /// one of x's (y repeats, once per such pair of voxels; x itself too).
+  /// Calls f(y) for every kept supervoxel y with a voxel within the
+  /// distance of one of x's (y repeats, once per such pair of voxels; x
+  /// itself too).
   template <typename F>
   void for_each(std::size_t x, F&& f) const {
     for (int m = first_[x]; m < first_[x + 1]; ++m) {
-      const Eigen::Vector3f& p = (*voxels_)[static_cast<std::size_t>(members_[static_cast<std::size_t>(m)])];
+      const Eigen::Vector3f& p = points_[static_cast<std::size_t>(m)];
       grid_.for_each_near(p, [&](int j) {
-        if (((*voxels_)[static_cast<std::size_t>(j)] - p).squaredNorm() <= radius2_) {
-          f(static_cast<std::size_t>((*owners_)[static_cast<std::size_t>(j)]));
+        if ((points_[static_cast<std::size_t>(j)] - p).squaredNorm() <= radius2_) {
+          f(static_cast<std::size_t>(owners_[static_cast<std::size_t>(j)]));
         }
       });
     }
   }
 
  private:
-  const std::vector<Eigen::Vector3f>* voxels_ = nullptr;
-  const std::vector<int>* owners_ = nullptr;
   float radius2_ = 0.0f;
+  std::vector<Eigen::Vector3f> points_;  // the kept voxels, grouped by supervoxel
+  std::vector<int> owners_;              // the supervoxel of each
+  std::vector<int> first_;               // supervoxel j's: points_[first_[j] .. first_[j + 1])
+  std::vector<int> next_;                // build()'s fill positions
   PointGrid grid_;
-  std::vector<int> first_;    // the voxels of supervoxel j: members_[first_[j] .. first_[j + 1])
-  std::vector<int> members_;
-  std::vector<int> next_;     // build()'s fill positions
 };
 
 }  // namespace detail

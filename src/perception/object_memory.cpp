@@ -99,11 +99,11 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   // (eq. 1's distance, here between voxels, not centroids: a strip revealed
   // along a distractor's edge, seen grazing, is a broken line of voxels
   // whose centroids lie farther than R_adj from the part it continues).
-  contacts.build(r, settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution);
   const auto alike = [&](std::size_t x, std::size_t y) {
     return detail::alike(r.supervoxels[x].colour, r.supervoxels[y].colour, t.max_chroma_distance);
   };
   const auto candidate = [&](std::size_t j) { return !object[j] && !on_plane(r.supervoxels[j]); };
+  contacts.build(r, settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution, candidate);
   const auto seen_not_object = [&](std::size_t j) {
     return 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0;
   };
@@ -123,7 +123,7 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
       open.pop_back();
       ambiguous = ambiguous || seen_not_object(x);
       contacts.for_each(x, [&](std::size_t y) {
-        if (component[y] < 0 && candidate(y) && alike(x, y)) {
+        if (component[y] < 0 && alike(x, y)) {
           component[y] = id;
           open.push_back(y);
         }
