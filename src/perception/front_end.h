@@ -204,13 +204,13 @@ struct Perception::Impl {
   bool initialised = false;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3f> memory;  // object voxels: seen now, or hidden behind something
-  std::vector<Eigen::Vector3f> holder;  // holder_body: the holder's voxels when last seen (grow_holder())
-  int holder_age = 0;                   // frames since the holder was last seen
-  detail::PointGrid holder_grid;
   std::vector<Eigen::Vector3f> memory_chroma;  // chromaticity of each memory voxel
   std::vector<int> memory_age;                 // frames since the voxel was last seen
   std::vector<Eigen::Vector3f> memory_normal;  // its supervoxel's normal then (0: none)
   detail::PointGrid seen_grid;                 // the frame's object voxels (remember())
+  std::vector<Eigen::Vector3f> holder;  // holder_body: the holder's voxels when last seen (grow_holder())
+  int holder_age = 0;                   // frames since the holder was last seen
+  detail::PointGrid holder_grid;
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
   bool incomplete = false;  // the first frame showed an occluder cutting the object (behind_occluders())
   RgbdFrame previous;  // the previous frame's depth, pose and intrinsics (no colour), with grow_revealed: grow_revealed()
@@ -260,6 +260,9 @@ struct Perception::Impl {
   /// object_memory.cpp: a later frame's object supervoxels, those near the
   /// remembered object voxels; sets voxel_matched.
   std::vector<char> track(const PerceptionResult& r);
+  /// True if a memory voxel of chromaticity c (within max_chroma_distance)
+  /// lies within radius (<= the cell of `grid`, built on `memory`) of p.
+  [[nodiscard]] bool remembered_near(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const;
   /// Grows `object` over surface the previous frame could not see (TrackingSettings::grow_revealed).
   void grow_revealed(const PerceptionResult& r, const std::vector<int>& near, std::vector<char>& object);
   /// pipeline.cpp: r.status and r.message from the object found; the first

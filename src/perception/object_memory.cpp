@@ -26,16 +26,10 @@ std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
   std::vector<int> near(n, 0);
   voxel_matched.assign(r.voxels.size(), 0);
   const auto radius = static_cast<float>(t.max_motion);
-  const auto max_chroma = static_cast<float>(t.max_chroma_distance);
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
-    const Eigen::Vector3f c = chroma(sv.colours[i]);
-    const bool is_near =
-        !plane_voxel(r.voxels[i], sv.colours[i]) &&
-        grid.any_within(r.voxels[i], radius, [&](int j) {
-          return max_chroma <= 0.0f ||
-                 (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
-        });
+    const bool is_near = !plane_voxel(r.voxels[i], sv.colours[i]) &&
+                         remembered_near(r.voxels[i], radius, chroma(sv.colours[i]));
     near[owner] += is_near ? 1 : 0;
     voxel_matched[i] = is_near ? 1 : 0;
   }
@@ -52,12 +46,18 @@ std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
   return object;
 }
 
+bool Perception::Impl::remembered_near(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const {
+  const auto max_chroma = static_cast<float>(settings.tracking.max_chroma_distance);
+  return grid.any_within(p, radius, [&](int j) {
+    return max_chroma <= 0.0f || (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
+  });
+}
+
 void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vector<int>& near,
                                      std::vector<char>& object) {
   if (previous.depth.empty()) return;
   const TrackingSettings& t = settings.tracking;
   const std::size_t n = r.supervoxels.size();
-  const auto max_chroma = static_cast<float>(t.max_chroma_distance);
   const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
   // A voxel the previous frame could not see (in its image, behind a
   // surface nearer its camera by more than max_motion) is the object's when
@@ -79,10 +79,7 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
     if (!(d < l->z - t.max_motion)) continue;
     const Eigen::Vector3f hider =
         (previous.wMc * Eigen::Vector3d((l->u - k.cx) * d / k.fx, (l->v - k.cy) * d / k.fy, d)).cast<float>();
-    const Eigen::Vector3f c = chroma(sv.colours[i]);
-    if (grid.any_within(hider, res, [&](int j) {
-          return max_chroma <= 0.0f || (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
-        })) {
+    if (remembered_near(hider, res, chroma(sv.colours[i]))) {
       voxel_revealed_here[i] = 1;
       ++revealed[owner];
     }
