@@ -409,6 +409,19 @@ TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
   EXPECT_GE(score.precision, 0.95);
 }
 
+/// The voxels of a panel standing 6 cm or more behind the case (y >= 0.06,
+/// above the table), and how many of them are in object supervoxels.
+std::pair<int, int> panel_voxels(const perception::PerceptionResult& r) {
+  int seen = 0;
+  int object = 0;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (r.voxels[i].y() < 0.06f || r.voxels[i].z() < 0.005f) continue;  // the panel, not the case or the table
+    ++seen;
+    object += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
+  }
+  return {seen, object};
+}
+
 TEST(Perception, SurfaceItsOwnFrontHidJoinsTheObjectWhenRevealed) {
   // The object has a lower panel standing 8 cm behind its front (a folded
   // sheet's far half), which the front hides from the first camera. As the
@@ -425,14 +438,8 @@ TEST(Perception, SurfaceItsOwnFrontHidJoinsTheObjectWhenRevealed) {
   off.tracking.grow_revealed = false;
   perception::Perception grow{on};
   perception::Perception stay{off};
-  const auto rear_recall = [&](const perception::PerceptionResult& r) {
-    int seen = 0;
-    int object = 0;
-    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-      if (r.voxels[i].y() < 0.06f || r.voxels[i].z() < 0.005f) continue;  // the panel, not the case or the table
-      ++seen;
-      object += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
-    }
+  const auto rear_recall = [](const perception::PerceptionResult& r) {
+    const auto [seen, object] = panel_voxels(r);
     return std::make_pair(seen, seen > 0 ? static_cast<double>(object) / seen : 0.0);
   };
   for (int k = 0; k <= 20; ++k) {
@@ -472,14 +479,7 @@ TEST(Perception, DistractorOfTheObjectsColourStaysOutAsTheObjectRevealsIt) {
     test::add_depth_noise(f.frame, 5u + static_cast<unsigned>(k));
     const perception::PerceptionResult r = perception.process(f.frame);
     ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << r.message;
-    int panel = 0;
-    int taken = 0;
-    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-      if (r.voxels[i].y() < 0.06f || r.voxels[i].z() < 0.005f) continue;  // the panel, not the case or the table
-      ++panel;
-      taken += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
-    }
-    if (std::getenv("OFV_DBG") && k >= 4 && k <= 5) for (std::size_t i = 0; i < r.voxels.size(); ++i) if (r.voxels[i].y() > 0.06f && r.voxels[i].z() > 0.085f) fprintf(stderr, "k%d x=%.3f y=%.3f z=%.3f sv=%d lab=%d\n", k, r.voxels[i].x(), r.voxels[i].y(), r.voxels[i].z(), r.voxel_owner[i], (int)r.supervoxels[(std::size_t)r.voxel_owner[i]].label);
+    const auto [panel, taken] = panel_voxels(r);
     ASSERT_GT(panel, 50) << "frame " << k << ": the camera does not see the panel";
     EXPECT_LE(taken, panel / 50) << "frame " << k << ": " << taken << " of the panel's " << panel << " voxels are the object's";
   }
