@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -144,40 +145,53 @@ class FaultySource : public FrameSource {
   std::vector<Delivered> delivered_;
 };
 
-/// A CameraRobot that records every command and throws at command `fail_at`
-/// (once, or on every command from then on when it `refuses`).
+/// A CameraRobot that records every command and throws at the loop's
+/// command `fail_at` (once, or on every command from then on when it
+/// `refuses`). The loop's commands (sent from the thread that built the robot)
+/// answer one frame each; the watchdog's stops (from its own thread, when a
+/// slow machine leaves the robot without a command for stale_timeout) answer
+/// none, so they are told apart.
 class FaultyRobot : public servo::CameraRobot {
  public:
   struct Command {
     vpColVector v;
     double dt;
     bool after_stop;  ///< the stop flag was up when it was sent
+    bool from_loop = true;
   };
   FaultyRobot(servo::CameraRobot& inner, long fail_at, bool refuses, const volatile std::sig_atomic_t* stop)
       : inner_(inner), fail_at_(fail_at), refuses_(refuses), stop_(stop) {}
   [[nodiscard]] vpHomogeneousMatrix wMc() const override { return inner_.wMc(); }
   servo::RobotStep step(const vpColVector& v, double dt) override {
-    const long n = static_cast<long>(commands_.size());
-    commands_.push_back({v, dt, *stop_ != 0});
-    if (n == fail_at_ || (refuses_ && fail_at_ >= 0 && n > fail_at_)) {
-      throw std::runtime_error("robot fault at command " + std::to_string(n));
+    // run_on_robot's watchdog holds its robot lock during every call: no two at once.
+    const bool from_loop = std::this_thread::get_id() == loop_thread_;
+    received_.push_back({v, dt, *stop_ != 0, from_loop});
+    if (from_loop) {
+      const long n = loop_commands_++;
+      if (n == fail_at_ || (refuses_ && fail_at_ >= 0 && n > fail_at_)) {
+        throw std::runtime_error("robot fault at command " + std::to_string(n));
+      }
     }
     return inner_.step(v, dt);
   }
   [[nodiscard]] std::string name() const override { return "faulty " + inner_.name(); }
-  [[nodiscard]] const std::vector<Command>& commands() const { return commands_; }
+  /// Every command, the watchdog's included, in the order received.
+  [[nodiscard]] const std::vector<Command>& received() const { return received_; }
 
  private:
   servo::CameraRobot& inner_;
   long fail_at_;
   bool refuses_;
   const volatile std::sig_atomic_t* stop_;
-  std::vector<Command> commands_;
+  const std::thread::id loop_thread_ = std::this_thread::get_id();
+  long loop_commands_ = 0;
+  std::vector<Command> received_;
 };
 
 /// One replay with faults: what the robot received and how the run ended.
 struct FaultRun {
-  std::vector<FaultyRobot::Command> commands;
+  std::vector<FaultyRobot::Command> received;  ///< every command, the watchdog's stops included
+  std::vector<FaultyRobot::Command> commands;  ///< the loop's: one per frame it answered, then its stops
   std::vector<FaultySource::Delivered> delivered;
   std::vector<servo::SafetyAction> actions;  ///< per frame the loop finished
   std::vector<servo::StepStatus> statuses;
@@ -190,6 +204,7 @@ struct FaultPlan {
   long robot_fails_at = -1;
   bool robot_refuses = false;
   long observer_throws_at = -1;
+  long observer_stalls_at = -1;  ///< the observer sleeps twice stale_timeout (a loaded machine)
   double max_duration = std::numeric_limits<double>::infinity();
 };
 
@@ -210,11 +225,16 @@ FaultRun replay(const FaultPlan& plan) {
       out.actions.push_back(f.step->safety);
       out.statuses.push_back(f.step->status);
       if (f.index == plan.observer_throws_at) throw std::runtime_error("observer fault");
+      if (f.index == plan.observer_stalls_at) {
+        std::this_thread::sleep_for(std::chrono::duration<double>(2.0 * rec.setup.loop.safety.stale_timeout));
+      }
     });
   } catch (const std::exception& e) {
     out.error = e.what();
   }
-  out.commands = robot.commands();
+  out.received = robot.received();
+  std::copy_if(out.received.begin(), out.received.end(), std::back_inserter(out.commands),
+               [](const FaultyRobot::Command& c) { return c.from_loop; });
   out.delivered = source.delivered();
   return out;
 }
@@ -224,7 +244,8 @@ double angular(const vpColVector& v) { return std::hypot(v[3], v[4], v[5]); }
 bool is_zero(const vpColVector& v) { return v.frobeniusNorm() == 0.0; }
 
 /**
- * The safety invariants, on every command the robot received:
+ * The safety invariants, on every command the robot received (1–3, 5, 6) and
+ * on the loop's answer to each frame (4):
  *  1. speed: |v| <= max_linear_speed, |w| <= max_angular_speed;
  *  2. acceleration: |dv| <= max_linear_accel dt, |dw| <= max_angular_accel dt
  *     from the previous command (the robot starts at rest), except for a
@@ -238,10 +259,10 @@ bool is_zero(const vpColVector& v) { return v.frobeniusNorm() == 0.0; }
  */
 void check_invariants(const FaultRun& run, const servo::SafetySettings& limits) {
   constexpr double eps = 1e-9;
-  ASSERT_FALSE(run.commands.empty());
+  ASSERT_FALSE(run.received.empty());
   vpColVector previous(6, 0.0);
-  for (std::size_t k = 0; k < run.commands.size(); ++k) {
-    const auto& c = run.commands[k];
+  for (std::size_t k = 0; k < run.received.size(); ++k) {
+    const auto& c = run.received[k];
     EXPECT_LE(linear(c.v), limits.max_linear_speed + eps) << "command " << k;
     EXPECT_LE(angular(c.v), limits.max_angular_speed + eps) << "command " << k;
     EXPECT_TRUE(std::isfinite(c.dt) && c.dt >= 0.0) << "command " << k << ": period " << c.dt;
@@ -252,7 +273,7 @@ void check_invariants(const FaultRun& run, const servo::SafetySettings& limits) 
     EXPECT_TRUE(!c.after_stop || is_zero(c.v)) << "command " << k << " sent after the stop flag";
     previous = c.v;
   }
-  EXPECT_TRUE(is_zero(run.commands.back().v)) << "the last command does not stop the robot";
+  EXPECT_TRUE(is_zero(run.received.back().v)) << "the last command does not stop the robot";
   std::optional<double> last;  // the last finite timestamp
   for (std::size_t k = 0; k < run.delivered.size() && k < run.commands.size(); ++k) {
     const FaultySource::Delivered& d = run.delivered[k];
@@ -297,6 +318,7 @@ TEST(Faults, SimulatedEpisodeKeepsTheSpeedAndAccelerationLimits) {
     }
   }
   r.commands.push_back({vpColVector(6, 0.0), 0.0, false});  // the episode's end: the robot is no longer stepped
+  r.received = r.commands;
   check_invariants(r, limits());
 }
 
@@ -344,6 +366,21 @@ TEST(Faults, TimestampGapsAndJumpsBackwardsStopTheRobot) {
   // A NaN timestamp stops one frame, not the rest of the run.
   EXPECT_FALSE(stops(r.actions.at(22)));
   EXPECT_FALSE(is_zero(r.commands.at(22).v));
+}
+
+TEST(Faults, ALoopThatStallsIsStoppedByTheWatchdogAndGoesOn) {
+  // The loop answers frame 6 late (its observer sleeps): the watchdog stops
+  // the robot meanwhile, the loop's next command starts from rest, and every
+  // frame still gets exactly one answer.
+  FaultPlan plan;
+  plan.observer_stalls_at = 6;
+  const FaultRun r = replay(plan);
+  EXPECT_FALSE(r.error);
+  EXPECT_GE(r.summary.watchdog_stops, 1);
+  EXPECT_GT(r.received.size(), r.commands.size());
+  EXPECT_EQ(r.commands.size(), r.delivered.size() + 1);
+  check_invariants(r, limits());
+  EXPECT_FALSE(is_zero(r.commands.at(12).v));
 }
 
 TEST(Faults, PoseJumpsKeepTheLimits) {
