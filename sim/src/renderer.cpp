@@ -179,7 +179,11 @@ struct Renderer::Impl {
 
 Renderer::Renderer(const Scenario& scenario, int surface_samples)
     : scenario_(scenario), impl_(std::make_unique<Impl>()) {
-  impl_->device = rtcNewDevice("threads=1");
+  // Embree's defaults: with TBB tasking, a "threads=N" configuration sets a
+  // process-wide tbb::global_control, so "threads=1" made every TBB loop of
+  // the process (ofv compare's episodes, the hindsight planner's views) serial
+  // while a renderer lived.
+  impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) throw std::runtime_error("Embree: cannot create a device");
   int occluder = 0;
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
