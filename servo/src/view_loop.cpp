@@ -97,6 +97,7 @@ struct ViewLoop::Impl {
   LoopSettings settings;
   EstimatorSettings estimator;
   ViewController controller;
+  std::optional<ViewController> tracker;  // follow()'s with a time to reach its target
   SafetyFilter safety;
   WorldModel world;
   int estimator_calls = 0;
@@ -121,7 +122,11 @@ LoopStep ViewLoop::step(const Observation& observation, double dt) {
 }
 
 LoopStep ViewLoop::follow(const Eigen::Vector3d& target, const Eigen::Vector3d& centroid, const Eigen::Isometry3d& wMc,
-                          double age, double dt) {
+                          double age, double dt, double within) {
+  if (!(std::isfinite(within) && within >= 0.0)) {
+    throw std::invalid_argument("ViewLoop::follow: the time to reach the target must be finite and >= 0, got " +
+                                format_number(within));
+  }
   LoopStep out;
   const auto start = Clock::now();
   out.status = StepStatus::Planned;
@@ -129,7 +134,18 @@ LoopStep ViewLoop::follow(const Eigen::Vector3d& target, const Eigen::Vector3d& 
   out.proposer = Proposer::Plan;
   out.target = target;
   const vpHomogeneousMatrix pose = to_visp(wMc);
-  out.command = impl_->controller.update(target, centroid, impl_->estimator.r_sphere, pose, dt);
+  ViewController* controller = &impl_->controller;
+  if (within > 0.0) {
+    if (!impl_->tracker || impl_->tracker->settings().gain != 1.0 / within) {
+      ControllerSettings c = impl_->settings.controller;
+      c.gain = 1.0 / within;
+      c.adaptive_gain = false;
+      c.target_filter = 0.0;
+      impl_->tracker.emplace(c);
+    }
+    controller = &*impl_->tracker;
+  }
+  out.command = controller->update(target, centroid, impl_->estimator.r_sphere, pose, dt);
   out.velocity = impl_->safety.filter(out.command, pose, dt, true, age);
   out.safety = impl_->safety.last_action();
   out.control_s = seconds_since(start);

@@ -13,6 +13,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -38,35 +39,117 @@ Eigen::Isometry3d looking_at(const Eigen::Vector3d& position, const Eigen::Vecto
   return wMc;
 }
 
-// For each direction, the directions within `chord` of it (itself first):
-// a grid of cells `chord` wide on the unit directions, 27 cells searched.
-std::vector<std::vector<int>> neighbours(const Eigen::Matrix3Xd& d, double chord) {
-  const auto n = static_cast<int>(d.cols());
-  const double cell = std::max(chord, 1e-6);
-  auto key_of = [cell](const Eigen::Vector3d& p, int dx, int dy, int dz) {
-    const auto q = [cell](double x, int dq) { return static_cast<long>(std::floor((x + 1.0) / cell)) + dq; };
-    return (q(p.x(), dx) * 4099L + q(p.y(), dy)) * 4099L + q(p.z(), dz);
-  };
-  std::unordered_map<long, std::vector<int>> cells;
-  for (int v = 0; v < n; ++v) cells[key_of(d.col(v), 0, 0, 0)].push_back(v);
-  std::vector<std::vector<int>> out(static_cast<std::size_t>(n));
-  tbb::parallel_for(0, n, [&](int v) {
-    std::vector<int>& near = out[static_cast<std::size_t>(v)];
-    near.push_back(v);
+// Unit directions hashed in cells `cell` wide: the directions within `cell`
+// of a point are in the 27 cells around it.
+class DirectionGrid {
+ public:
+  DirectionGrid(const Eigen::Matrix3Xd& d, double cell) : d_(d), cell_(std::max(cell, 1e-6)) {
+    for (int v = 0; v < static_cast<int>(d.cols()); ++v) cells_[key_of(d.col(v), 0, 0, 0)].push_back(v);
+  }
+  // Calls f(u) for every direction u within `radius` (<= the cell) of p.
+  template <typename F>
+  void within(const Eigen::Vector3d& p, double radius, F&& f) const {
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find(key_of(d.col(v), dx, dy, dz));
-          if (it == cells.end()) continue;
+          const auto it = cells_.find(key_of(p, dx, dy, dz));
+          if (it == cells_.end()) continue;
           for (const int u : it->second) {
-            if (u != v && (d.col(u) - d.col(v)).norm() <= chord) near.push_back(u);
+            if ((d_.col(u) - p).norm() <= radius) f(u);
           }
         }
       }
     }
+  }
+  // The direction nearest p, if one lies within the cell.
+  [[nodiscard]] int nearest(const Eigen::Vector3d& p) const {
+    int best = -1;
+    double best_distance = std::numeric_limits<double>::infinity();
+    within(p, cell_, [&](int u) {
+      const double distance = (d_.col(u) - p).norm();
+      if (distance < best_distance || (distance == best_distance && u < best)) {
+        best_distance = distance;
+        best = u;
+      }
+    });
+    return best;
+  }
+
+ private:
+  [[nodiscard]] long key_of(const Eigen::Vector3d& p, int dx, int dy, int dz) const {
+    const auto q = [this](double x, int dq) { return static_cast<long>(std::floor((x + 1.0) / cell_)) + dq; };
+    return (q(p.x(), dx) * 4099L + q(p.y(), dy)) * 4099L + q(p.z(), dz);
+  }
+  const Eigen::Matrix3Xd& d_;
+  double cell_;
+  std::unordered_map<long, std::vector<int>> cells_;
+};
+
+// For each direction, the directions within `chord` of it (itself first).
+std::vector<std::vector<int>> neighbours(const Eigen::Matrix3Xd& d, double chord) {
+  const DirectionGrid grid(d, chord);
+  std::vector<std::vector<int>> out(static_cast<std::size_t>(d.cols()));
+  tbb::parallel_for(0, static_cast<int>(d.cols()), [&](int v) {
+    std::vector<int>& near = out[static_cast<std::size_t>(v)];
+    near.push_back(v);
+    grid.within(d.col(v), chord, [&](int u) {
+      if (u != v) near.push_back(u);
+    });
   });
   return out;
 }
+
+// The direction a fraction f of the way from a to b on the great circle.
+Eigen::Vector3d between(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double f) {
+  return Eigen::Quaterniond::Identity().slerp(f, Eigen::Quaterniond::FromTwoVectors(a, b)) * a;
+}
+
+// Straight moves of k steps into each view v: from a view u whose direction
+// is at most `chord` per step away along the great circle (2 sin(angle/2k)
+// <= chord), with the views nearest the directions at the k - 1 steps in
+// between (they stand for the camera there, as each view stands for its
+// cell of the sphere).
+struct Segments {
+  int k = 1;
+  std::vector<std::size_t> first;  // view v's segments: [first[v], first[v + 1])
+  std::vector<int> from;           // u
+  std::vector<float> step_chord;   // 2 sin(angle(u, v) / 2k): the move per step on the unit sphere
+  std::vector<int> mids;           // k - 1 per segment, at steps 1 .. k - 1 from u
+
+  Segments(const Eigen::Matrix3Xd& d, int steps, double chord, double spacing) : k(steps) {
+    const auto n = static_cast<std::size_t>(d.cols());
+    first.assign(n + 1, 0);
+    if (k < 2) return;
+    const DirectionGrid partners(d, std::min(2.0, k * chord));
+    const DirectionGrid fine(d, 2.0 * spacing);
+    std::vector<std::vector<int>> from_of(n), mids_of(n);
+    std::vector<std::vector<float>> chord_of(n);
+    tbb::parallel_for(0, static_cast<int>(n), [&](int v) {
+      const auto sv = static_cast<std::size_t>(v);
+      partners.within(d.col(v), std::min(2.0, k * chord), [&](int u) {
+        if (u == v) return;
+        const double angle = std::acos(std::clamp(d.col(u).dot(d.col(v)), -1.0, 1.0));
+        const double per_step = 2.0 * std::sin(angle / (2.0 * k));
+        if (per_step > chord || angle > kPi - 1e-6) return;  // too far, or no one great circle
+        from_of[sv].push_back(u);
+        chord_of[sv].push_back(static_cast<float>(per_step));
+        for (int g = 1; g < k; ++g) {
+          const int mid = fine.nearest(between(d.col(u), d.col(v), static_cast<double>(g) / k));
+          mids_of[sv].push_back(mid >= 0 ? mid : (2 * g < k ? u : v));
+        }
+      });
+    });
+    for (std::size_t v = 0; v < n; ++v) first[v + 1] = first[v] + from_of[v].size();
+    from.reserve(first[n]);
+    step_chord.reserve(first[n]);
+    mids.reserve(first[n] * static_cast<std::size_t>(k - 1));
+    for (std::size_t v = 0; v < n; ++v) {
+      from.insert(from.end(), from_of[v].begin(), from_of[v].end());
+      step_chord.insert(step_chord.end(), chord_of[v].begin(), chord_of[v].end());
+      mids.insert(mids.end(), mids_of[v].begin(), mids_of[v].end());
+    }
+  }
+};
 
 // A ball around a part of the scene.
 struct Ball {
@@ -166,9 +249,17 @@ void check_hindsight(const HindsightSettings& s, double r_sphere, double duratio
     throw std::invalid_argument("setting 'hindsight_step' must be at least 1 frame, got " +
                                 std::to_string(s.frames_per_step));
   }
+  if (s.segment_steps < 1 || s.segment_steps > 8) {
+    throw std::invalid_argument("setting 'hindsight_segment' must be 1 to 8 steps, got " +
+                                std::to_string(s.segment_steps));
+  }
   if (!(std::isfinite(s.max_speed) && s.max_speed > 0.0)) {
     throw std::invalid_argument("hindsight planner: the speed limit must be finite and positive, got " +
                                 format_number(s.max_speed));
+  }
+  if (!(std::isfinite(s.max_turn_rate) && s.max_turn_rate > 0.0)) {
+    throw std::invalid_argument("hindsight planner: the turn rate must be finite and positive, got " +
+                                format_number(s.max_turn_rate));
   }
   if (!(std::isfinite(r_sphere) && r_sphere > 0.0)) {
     throw std::invalid_argument("hindsight planner: r_sphere must be positive, got " + format_number(r_sphere));
@@ -223,6 +314,7 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   plan.lattice_views = n;
   const Eigen::Matrix3Xd d = fibonacci_directions(n);
   const std::vector<std::vector<int>> near = neighbours(d, (reach + max_shift) / r_sphere);
+  const Segments segments(d, settings.segment_steps, reach / r_sphere, settings.spacing / r_sphere);
 
   // The approach: from the start along the radius to the sphere, `reach` a step.
   const Eigen::Vector3d start = wMc_start.translation();
@@ -237,15 +329,39 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   }
 
   // States: lattice views 0..n-1, then the approach n..n+chain (n is the start).
+  // The best totals of the last K + 1 steps (K = segment steps), in turn.
+  const int K = segments.k;
   const auto states = static_cast<std::size_t>(n + chain + 1);
-  std::vector<double> total(states, kUnreached), next(states);
+  std::vector<std::vector<double>> totals(static_cast<std::size_t>(K + 1), std::vector<double>(states, kUnreached));
+  const auto total_at = [&](long i) -> std::vector<double>& { return totals[static_cast<std::size_t>(i % (K + 1))]; };
+  // How each state was reached: the state before the move and the move's steps (1 or K).
   std::vector<std::vector<int>> from(static_cast<std::size_t>(steps), std::vector<int>(states, -1));
+  std::vector<std::vector<std::uint8_t>> move(static_cast<std::size_t>(steps), std::vector<std::uint8_t>(states, 1));
+  // Values of the lattice views looking at the centroid, and of every state as the camera there can be turned.
+  std::vector<std::vector<double>> looking(static_cast<std::size_t>(steps), std::vector<double>(static_cast<std::size_t>(n), 0.0));
   std::vector<std::vector<double>> value(static_cast<std::size_t>(steps), std::vector<double>(states, 0.0));
   auto position = [&](std::size_t s, long i) -> Eigen::Vector3d {
     return s < static_cast<std::size_t>(n) ? Eigen::Vector3d(c[static_cast<std::size_t>(i)] + r_sphere * d.col(static_cast<Eigen::Index>(s)))
                                            : a[s - static_cast<std::size_t>(n)];
   };
-
+  // The camera at o at step i, turned from its start towards the centroid by
+  // at most max_turn_rate x the time (at time 0: as the scenario places it);
+  // whether it looks at the centroid yet.
+  const Eigen::Vector3d start_axis = wMc_start.linear().col(2);
+  auto aimed = [&](const Eigen::Vector3d& o, long i, bool* turned) {
+    const auto si = static_cast<std::size_t>(i);
+    const Eigen::Vector3d look = (c[si] - o).normalized();
+    const double need = std::acos(std::clamp(start_axis.dot(look), -1.0, 1.0));
+    const double allowed = settings.max_turn_rate * plan.times[si];
+    *turned = need <= allowed;
+    if (*turned) return looking_at(o, c[si], wMc_start);
+    Eigen::Isometry3d wMc = wMc_start;
+    wMc.linear() = (Eigen::Quaterniond::Identity().slerp(allowed / need, Eigen::Quaterniond::FromTwoVectors(start_axis, look)) *
+                    Eigen::Quaterniond(wMc_start.linear()))
+                       .toRotationMatrix();
+    wMc.translation() = o;
+    return wMc;
+  };
   std::vector<TriangleMesh> meshes(scenario.bodies.size());
   std::vector<std::vector<Ball>> pieces(scenario.bodies.size());  // of the bodies that moved, at the last step
   for (long i = 0; i < steps; ++i) {
@@ -273,53 +389,83 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     } else if (i > 0) {
       c[si] = c[si - 1];
     }
-    // Every lattice view (the unlimited bound needs them all) that may have
-    // changed since the last step, and the approach states reached by now.
+    // Every lattice view looking at the centroid (the unlimited bound needs
+    // them all) that may have changed since the last step.
     std::vector<int> evaluate;
     std::vector<Eigen::Isometry3d> poses;
     for (int v = 0; v < n; ++v) {
       const Eigen::Vector3d o = position(static_cast<std::size_t>(v), i);
       if (i > 0 && !may_change(changes, o)) {
-        value[si][static_cast<std::size_t>(v)] = value[si - 1][static_cast<std::size_t>(v)];
+        looking[si][static_cast<std::size_t>(v)] = looking[si - 1][static_cast<std::size_t>(v)];
         continue;
       }
       evaluate.push_back(v);
       poses.push_back(looking_at(o, c[si], wMc_start));
     }
-    // At time 0 the camera is as the scenario puts it (the object may be
-    // off its image); from the first step on it is taken to look at the centroid.
+    renderer.set_time(plan.times[si]);
+    if (!poses.empty()) {
+      const std::vector<double> seen = renderer.visible_fractions(poses);
+      plan.evaluations += static_cast<long>(seen.size());
+      for (std::size_t k = 0; k < seen.size(); ++k) looking[si][static_cast<std::size_t>(evaluate[k])] = seen[k];
+    }
+    plan.best_visible.push_back(*std::max_element(looking[si].begin(), looking[si].end()));
+    // The programme's values: the camera's, which cannot look at the
+    // centroid before it has turned there. Views the camera can have reached
+    // by now that it could not have turned at yet are cast as turned so far;
+    // the approach states reached, as the camera there is turned by now.
+    std::copy(looking[si].begin(), looking[si].end(), value[si].begin());
+    evaluate.clear();
+    poses.clear();
+    for (int v = 0; v < n && i > 0; ++v) {
+      const Eigen::Vector3d o = position(static_cast<std::size_t>(v), i);
+      if ((o - start).norm() > static_cast<double>(i) * reach + 1e-9) continue;  // out of reach yet
+      bool turned = false;
+      Eigen::Isometry3d pose = aimed(o, i, &turned);
+      if (turned) continue;
+      evaluate.push_back(v);
+      poses.push_back(pose);
+    }
     for (int j = 0; j <= std::min<long>(chain, i); ++j) {
       const Eigen::Vector3d& o = a[static_cast<std::size_t>(j)];
-      const bool aimed_before = j < i && !(i == 1 && j == 0);
-      if (aimed_before && !may_change(changes, o)) {
+      bool turned_before = false;
+      if (j < i) (void)aimed(o, i - 1, &turned_before);
+      if (turned_before && !may_change(changes, o)) {
         value[si][static_cast<std::size_t>(n + j)] = value[si - 1][static_cast<std::size_t>(n + j)];
         continue;
       }
+      bool turned = false;
       evaluate.push_back(n + j);
-      poses.push_back(i == 0 ? wMc_start : looking_at(o, c[si], wMc_start));
+      poses.push_back(aimed(o, i, &turned));
     }
-    if (poses.empty()) {
-      plan.best_visible.push_back(plan.best_visible.back());
-    } else {
-      renderer.set_time(plan.times[si]);
+    if (!poses.empty()) {
       const std::vector<double> seen = renderer.visible_fractions(poses);
       plan.evaluations += static_cast<long>(seen.size());
       for (std::size_t k = 0; k < seen.size(); ++k) value[si][static_cast<std::size_t>(evaluate[k])] = seen[k];
-      plan.best_visible.push_back(*std::max_element(value[si].begin(), value[si].begin() + n));
     }
 
     if (i == 0) {
-      total[static_cast<std::size_t>(n)] = value[si][static_cast<std::size_t>(n)];
+      total_at(0)[static_cast<std::size_t>(n)] = value[si][static_cast<std::size_t>(n)];
       continue;
     }
+    const std::vector<double>& total = total_at(i - 1);
+    std::vector<double>& next = total_at(i);
     std::fill(next.begin(), next.end(), kUnreached);
-    // Lattice views: from a neighbour within reach, or from the end of the approach.
+    // Lattice views: from a neighbour within reach, from the end of the
+    // approach, or by a straight move of K steps (its centroid's largest move
+    // in a step plus the camera's on the sphere within reach).
     const std::size_t end = static_cast<std::size_t>(n + chain);
+    double shift = 0.0;
+    for (long j = std::max(1L, i - K + 1); j <= i && K > 1; ++j) {
+      shift = std::max(shift, (c[static_cast<std::size_t>(j)] - c[static_cast<std::size_t>(j - 1)]).norm());
+    }
+    const std::vector<double>* before_move = i >= K && K > 1 ? &total_at(i - K) : nullptr;
     tbb::parallel_for(0, n, [&](int v) {
-      const Eigen::Vector3d here = position(static_cast<std::size_t>(v), i);
+      const auto sv = static_cast<std::size_t>(v);
+      const Eigen::Vector3d here = position(sv, i);
       double best = kUnreached;
       int arg = -1;
-      for (const int u : near[static_cast<std::size_t>(v)]) {
+      std::uint8_t steps_of_move = 1;
+      for (const int u : near[sv]) {
         const double t = total[static_cast<std::size_t>(u)];
         if (t > best && (here - position(static_cast<std::size_t>(u), i - 1)).norm() <= reach) {
           best = t;
@@ -330,9 +476,23 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
         best = total[end];
         arg = static_cast<int>(end);
       }
+      if (before_move != nullptr) {
+        for (std::size_t g = segments.first[sv]; g < segments.first[sv + 1]; ++g) {
+          double t = (*before_move)[static_cast<std::size_t>(segments.from[g])];
+          if (!(t > kUnreached) || shift + r_sphere * segments.step_chord[g] > reach) continue;
+          const int* mid = &segments.mids[g * static_cast<std::size_t>(K - 1)];
+          for (int m = 1; m < K; ++m) t += value[si - static_cast<std::size_t>(K - m)][static_cast<std::size_t>(mid[m - 1])];
+          if (t > best) {
+            best = t;
+            arg = segments.from[g];
+            steps_of_move = static_cast<std::uint8_t>(K);
+          }
+        }
+      }
       if (arg >= 0) {
-        next[static_cast<std::size_t>(v)] = best + value[si][static_cast<std::size_t>(v)];
-        from[si][static_cast<std::size_t>(v)] = arg;
+        next[sv] = best + value[si][sv];
+        from[si][sv] = arg;
+        move[si][sv] = steps_of_move;
       }
     });
     // The approach: stay, or go one state on.
@@ -349,22 +509,41 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
         from[si][s] = arg;
       }
     }
-    total.swap(next);
   }
 
   // The best final state (the approach's end first: of equal paths, the one
-  // that moves least), then back to the start.
+  // that moves least), then back to the start. A straight move's steps lie
+  // on its great circle; the nearest views stood for them in the programme,
+  // the path's own values are then cast from where the camera is.
+  const std::vector<double>& final_total = total_at(steps - 1);
   std::size_t last = static_cast<std::size_t>(n + chain);
   for (std::size_t s = 0; s < static_cast<std::size_t>(n); ++s) {
-    if (total[s] > total[last]) last = s;
+    if (final_total[s] > final_total[last]) last = s;
   }
   plan.views.resize(static_cast<std::size_t>(steps));
   plan.visible.resize(static_cast<std::size_t>(steps));
-  for (long i = steps - 1; i >= 0; --i) {
+  std::vector<std::size_t> inside;  // steps inside straight moves
+  for (long i = steps - 1; i >= 0;) {
     const auto si = static_cast<std::size_t>(i);
     plan.views[si] = position(last, i);
     plan.visible[si] = value[si][last];
-    if (i > 0) last = static_cast<std::size_t>(from[si][last]);
+    if (i == 0) break;
+    const int k = move[si][last];
+    const auto u = static_cast<std::size_t>(from[si][last]);
+    for (int m = 1; m < k; ++m) {
+      const auto sj = si - static_cast<std::size_t>(k - m);
+      plan.views[sj] = c[sj] + r_sphere * between(d.col(static_cast<Eigen::Index>(u)),
+                                                  d.col(static_cast<Eigen::Index>(last)), static_cast<double>(m) / k);
+      inside.push_back(sj);
+    }
+    last = u;
+    i -= k;
+  }
+  for (const std::size_t sj : inside) {
+    renderer.set_time(plan.times[sj]);
+    bool turned = false;
+    plan.visible[sj] = renderer.visible_fractions({aimed(plan.views[sj], static_cast<long>(sj), &turned)}).front();
+    ++plan.evaluations;
   }
   plan.centroids = c;
   const auto mean = [](const std::vector<double>& x) {

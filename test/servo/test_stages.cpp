@@ -226,6 +226,37 @@ TEST(ViewLoop, FollowDrivesToTheGivenViewThroughTheSafetyFilter) {
   // A frame older than the stale timeout: no motion.
   const LoopStep stale = loop.follow(view, centroid, Eigen::Isometry3d::Identity(), 10.0, 1.0 / 30.0);
   EXPECT_EQ(stale.velocity.frobeniusNorm(), 0.0);
+  EXPECT_THROW((void)loop.follow(view, centroid, Eigen::Isometry3d::Identity(), 0.0, 1.0 / 30.0, -1.0),
+               std::invalid_argument);
+}
+
+// A path given in advance is tracked: with a time to reach the target, a
+// camera moving along the path at its speed is commanded that speed (the
+// loop's own gain would command a fraction of it and fall behind).
+TEST(ViewLoop, FollowWithinATimeTracksAPathAtItsSpeed) {
+  LoopSettings settings;
+  settings.method = ViewMethod::Hindsight;
+  const double dt = 1.0 / 30.0;
+  const Eigen::Vector3d centroid(0.0, 0.0, 0.5);
+  const auto on_path = [&](double t) {  // 0.3 m/s around the sphere in the x-z plane, from the camera at the origin
+    const double a = 0.3 * t / 0.5;
+    return Eigen::Vector3d(centroid + 0.5 * Eigen::Vector3d(std::sin(a), 0.0, -std::cos(a)));
+  };
+  const auto speed_after = [&](double within, int frames) {
+    ViewLoop loop(settings);
+    Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+    LoopStep s;
+    for (int k = 0; k < frames; ++k) {
+      const double t = k * dt;
+      wMc.translation() = on_path(t);  // the camera is on the path, turned to look at C
+      wMc.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), (centroid - on_path(t)).normalized())
+                         .toRotationMatrix();
+      s = loop.follow(on_path(t + (within > 0.0 ? within : dt)), centroid, wMc, dt, dt, within);
+    }
+    return std::hypot(s.velocity[0], s.velocity[1], s.velocity[2]);
+  };
+  EXPECT_NEAR(speed_after(dt, 30), 0.3, 0.003);
+  EXPECT_LT(speed_after(0.0, 30), 0.3 * 0.5);  // the loop's controller, one frame ahead: lags
 }
 
 }  // namespace

@@ -109,6 +109,11 @@ SettingsTable<EpisodeSetup> make_table() {
          "method hindsight: the planner's time step, in frame periods"},
         [](E& e, const std::string& v) { e.hindsight.frames_per_step = static_cast<int>(parse_integer("hindsight_step", v, 1, 30)); },
         [](const E& e) { return std::to_string(e.hindsight.frames_per_step); });
+  t.add({"hindsight_segment", "integer in [1, 8]", std::to_string(d.hindsight.segment_steps), "steps",
+         "method hindsight: the longest straight move at full speed between two views, in steps (1: one step at a "
+         "time, which a lattice slows to about 0.6 of the speed limit)"},
+        [](E& e, const std::string& v) { e.hindsight.segment_steps = static_cast<int>(parse_integer("hindsight_segment", v, 1, 8)); },
+        [](const E& e) { return std::to_string(e.hindsight.segment_steps); });
   t.add({"poses", "simulator | robot | odometry[:icp|rgbd_icp|fast_icp|rgbd]", poses_word(d), "",
          "the camera pose the front end and the loop get: the frame's own (simulator: the true pose; ofv run: the "
          "robot's or the recording's; robot says the same), or RGB-D odometry from the first frame's pose (OpenCV's "
@@ -241,10 +246,11 @@ void record_step(StepRecord& rec, const servo::LoopStep& step) {
   for (unsigned i = 0; i < 6; ++i) rec.velocity(i) = step.velocity[i];
 }
 
-// Method hindsight's planner: the setup's lattice and step, the loop's speed limit.
+// Method hindsight's planner: the setup's lattice and step, the loop's speed limits.
 sim::HindsightSettings planner_settings(const EpisodeSetup& setup) {
   sim::HindsightSettings h = setup.hindsight;
   h.max_speed = setup.loop.controller.max_linear_speed;
+  h.max_turn_rate = setup.loop.controller.max_angular_speed;
   return h;
 }
 
@@ -366,16 +372,15 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   const std::string poses = poses_word(setup);
   std::optional<double> object_depth;  // the object's nearest depth in the last frame, for the pose source
 
-  // Method hindsight: the path planned from the whole episode, followed a
-  // controller time constant (the adaptive gain's at zero error) plus the
-  // latency ahead, so that the camera is on it rather than behind it.
+  // Method hindsight: the path planned from the whole episode, tracked: the
+  // command of each frame aims at where the path is when the command's
+  // period ends (one period plus the latency ahead), reached in that time.
   std::optional<sim::HindsightPlan> plan;
   double lead = 0.0;
   if (setup.loop.method == ViewMethod::Hindsight) {
     plan = sim::plan_hindsight(scenario, scenario.wMc_start, loop.estimator().r_sphere, setup.duration,
                                planner_settings(setup));
-    const servo::ControllerSettings& c = setup.loop.controller;
-    lead = dt * setup.latency + 1.0 / (c.adaptive_gain ? 2.0 * c.gain : c.gain);
+    lead = dt * (1 + setup.latency);
   }
 
   // Commands on their way to the robot, oldest first.
@@ -405,7 +410,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     servo::LoopStep step;
     if (plan) {
       const double ahead = rec.time + lead;
-      step = loop.follow(plan->view_at(ahead), plan->centroid_at(ahead), wMc, age, dt);
+      step = loop.follow(plan->view_at(ahead), plan->centroid_at(ahead), wMc, age, dt, lead);
     } else {
       start = Clock::now();
       if (setup.perception != PerceptionMode::GroundTruth && !perception) {

@@ -229,9 +229,15 @@ class ViewLoop {
    * \param wMc      the camera's pose when the frame was taken.
    * \param age      the frame's age when the command is sent [s] (as Observation::age).
    * \param dt       as step().
+   * \param within   0: the loop's controller approaches the target as it
+   *                 approaches a view it chose. Positive: the time in which
+   *                 to reach it [s]: the same control law with gain 1/within,
+   *                 not adaptive, no target filter, so that a path given in
+   *                 advance at the path's time + within is tracked, not
+   *                 approached (a moving target is otherwise lagged or cut across).
    */
   [[nodiscard]] LoopStep follow(const Eigen::Vector3d& target, const Eigen::Vector3d& centroid,
-                                const Eigen::Isometry3d& wMc, double age, double dt);
+                                const Eigen::Isometry3d& wMc, double age, double dt, double within = 0.0);
 
   /// \brief The robot was stopped outside the loop (a watchdog, a skipped
   ///        frame): the next command starts from rest within the

@@ -90,7 +90,7 @@ struct EpisodeSetup {
   /// of wall-clock time per step: a real-time demo, not exactly repeatable.
   bool real_time = false;
   /// Method hindsight: the planner's lattice spacing and time step (settings
-  /// hindsight_spacing, hindsight_step); its speed limit is the loop's max_linear_speed.
+  /// hindsight_spacing, hindsight_step, hindsight_segment); its speed limit is the loop's max_linear_speed.
   sim::HindsightSettings hindsight;
   PoseOrigin poses = PoseOrigin::Frame;  ///< setting `poses`
   /// With PoseOrigin::Odometry: OpenCV's method, a word of
@@ -104,7 +104,7 @@ struct EpisodeSetup {
  * \brief Every setting of an episode by name: the loop's
  *        (ofv::servo::loop_settings_table()), the front end's
  *        (ofv::perception::perception_settings_table()) and robot, perception, select,
- *        duration, seed, latency, real_time, hindsight_spacing, hindsight_step, poses. `ofv simulate`, `ofv run`, `ofv compare`, scenario
+ *        duration, seed, latency, real_time, hindsight_spacing, hindsight_step, hindsight_segment, poses. `ofv simulate`, `ofv run`, `ofv compare`, scenario
  *        `controller` sections and grids all read settings through it.
  */
 [[nodiscard]] const SettingsTable<EpisodeSetup>& episode_settings_table();
