@@ -19,6 +19,7 @@ packages=(
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib  # python/: the module ofv, its tests and tutorial
   clang libclang-rt-14-dev  # scripts/fuzz.sh: clang++ -fsanitize=fuzzer (libFuzzer)
   doxygen  # the API reference: cmake --build build --target doc (cmake/Doxyfile.in)
+  visp-images-data  # ViSP's castel recording: odometry against ViSP's model-based tracker (Castel.*), 75 MB
 )
 # --cluster: also what the sweep tests of ctest label `cluster` need (a
 # single-node Slurm cluster, GNU parallel). Not by default: on a machine with
