@@ -34,7 +34,8 @@ namespace ofv::cli {
 namespace {
 
 constexpr const char* kSourceHelp = R"(Sources:
-  DIR                 a TUM RGB-D sequence (depth.txt, rgb.txt, depth/, rgb/, groundtruth.txt)
+  DIR                 a TUM RGB-D sequence (depth.txt, rgb.txt, depth/, rgb/, groundtruth.txt;
+                      with --poses odometry groundtruth.txt may be left out)
   DIR                 a PCD sequence (*.pcd organised clouds, camera frame, + poses.txt)
   FILE.oni            an OpenNI2 recording (poses from FILE.oni.poses.txt if present)
   openni2://URI       a live OpenNI2 device (openni2:// alone: the first device)
@@ -195,7 +196,7 @@ Command add_perceive_command(CLI::App& app) {
               odometry::odometry_settings_table().apply(odometry_settings, odometry_sets);
               odometry::validate(odometry_settings);
 #endif
-              source = open_source(opt->source, opt->speed);
+              source = open_source(opt->source, opt->speed, !use_odometry);
               if (!opt->out.empty()) {
                 std::error_code ec;
                 fs::create_directories(opt->out, ec);

@@ -294,7 +294,7 @@ Command add_run_command(CLI::App& app) {
                   throw std::invalid_argument("--robot " + opt->robot + ": unknown (simulated: camera, viper850, afma6; real drivers: " +
                                               real_drivers() + ")");
                 }
-                source = open_source(opt->source, 1.0f);
+                source = open_source(opt->source, 1.0f, setup.poses != PoseOrigin::Odometry);
               }
             } catch (const std::exception& e) {  // sources report unreadable paths as runtime errors: here they are bad input
               std::cerr << "ofv run: " << e.what() << '\n';

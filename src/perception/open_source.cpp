@@ -13,7 +13,7 @@ namespace fs = std::filesystem;
 
 namespace ofv {
 
-std::unique_ptr<FrameSource> open_source(const std::string& source, float playback_speed) {
+std::unique_ptr<FrameSource> open_source(const std::string& source, float playback_speed, bool source_poses) {
   OpenNi2Options oni;
   oni.playback_speed = playback_speed;
   const std::string scheme = "openni2://";
@@ -29,7 +29,9 @@ std::unique_ptr<FrameSource> open_source(const std::string& source, float playba
   }
   if (fs::is_directory(source)) {
     if (fs::exists(fs::path(source) / "depth.txt")) {
-      return std::make_unique<TumSequenceSource>(source);
+      TumSequenceOptions tum;
+      tum.require_poses = source_poses;
+      return std::make_unique<TumSequenceSource>(source, tum);
     }
     for (const auto& entry : fs::directory_iterator(source)) {
       if (entry.path().extension() == ".pcd") {

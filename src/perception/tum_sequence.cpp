@@ -124,10 +124,15 @@ TumSequenceSource::TumSequenceSource(const std::string& directory,
   if (fs::exists(dir / "object.txt")) objects_ = read_pose_file((dir / "object.txt").string());
   const std::string ground_truth = (dir / "groundtruth.txt").string();
   if (!fs::exists(ground_truth)) {
-    throw std::invalid_argument(ground_truth + ": missing (the camera pose of each depth image)");
+    if (options.require_poses) {
+      throw std::invalid_argument(ground_truth +
+                                  ": missing (the camera pose of each depth image; without it, poses from RGB-D "
+                                  "odometry: --poses odometry)");
+    }
+  } else {
+    poses_ = read_pose_file(ground_truth);
   }
-  poses_ = read_pose_file(ground_truth);
-  for (const Entry& e : entries_) {
+  for (const Entry& e : poses_.empty() ? std::vector<Entry>{} : entries_) {
     const auto after = std::lower_bound(poses_.begin(), poses_.end(), e.time,
                                         [](const StampedPose& p, double t) { return p.time < t; });
     double gap = std::numeric_limits<double>::infinity();
@@ -159,7 +164,7 @@ std::optional<RgbdFrame> TumSequenceSource::next() {
   RgbdFrame f;
   f.timestamp = e.time - entries_.front().time;
   f.intrinsics = intrinsics_;
-  f.wMc = interpolate_pose(poses_, e.time);
+  f.wMc = poses_.empty() ? Eigen::Isometry3d::Identity() : interpolate_pose(poses_, e.time);
 
   const std::string depth_path = (dir / e.depth).string();
   Png depth(depth_path, "depth image");

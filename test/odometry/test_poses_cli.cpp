@@ -56,6 +56,31 @@ TEST(PosesCli, SourcePosesAreTheRecordingsOwn) {
   for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_TRUE(poses[k].wMc.isApprox(truth[k].wMc, 1e-9));
 }
 
+TEST(PosesCli, ARecordingWithoutPosesNeedsOdometryAndGetsItsMotion) {
+  // A TUM folder without groundtruth.txt (a handheld sensor, no tracker):
+  // odometry gives its poses from the identity; the source's own cannot.
+  const fs::path bare = fs::path(test::scratch_dir()) / "without_poses";
+  fs::remove_all(bare);
+  fs::copy(recording(), bare, fs::copy_options::recursive);
+  fs::remove(bare / "groundtruth.txt");
+  const CommandRun refused = run("perceive " + bare.string() + " --max-frames 3");
+  EXPECT_EQ(refused.code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("groundtruth.txt"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--poses odometry"), std::string::npos) << refused.err;
+
+  const std::string out = (fs::path(test::scratch_dir()) / "without_poses_out").string();
+  const CommandRun r = run("perceive " + bare.string() + " --poses odometry --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto truth = read_pose_file(recording() + "/groundtruth.txt");
+  const auto poses = read_pose_file(out + "/poses.txt");
+  ASSERT_EQ(poses.size(), truth.size());
+  EXPECT_TRUE(poses.front().wMc.isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  for (std::size_t k = 1; k < poses.size(); ++k) {  // the camera's motion from its first pose, within 2 mm
+    const Eigen::Isometry3d moved = truth.front().wMc.inverse() * truth[k].wMc;
+    EXPECT_LT((poses[k].wMc.translation() - moved.translation()).norm(), 0.002) << "frame " << k;
+  }
+}
+
 TEST(PosesCli, UnknownMethodIsAUsageError) {
   const CommandRun r = run("perceive " + recording() + " --poses odometry:nope");
   EXPECT_EQ(r.code, 2);

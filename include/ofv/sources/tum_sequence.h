@@ -35,6 +35,9 @@ struct TumSequenceOptions {
   /// a frame without a pose is an error, not the identity or the last pose.
   double max_pose_time_difference = 0.02;
   std::optional<CameraIntrinsics> intrinsics;  ///< overrides intrinsics.txt and the default
+  /// False: the camera poses come from elsewhere (RGB-D odometry), and a
+  /// sequence without groundtruth.txt is read with the identity for wMc.
+  bool require_poses = true;
 };
 
 /**
@@ -47,8 +50,9 @@ struct TumSequenceOptions {
 class TumSequenceSource : public FrameSource {
  public:
   /// \throws std::runtime_error naming the path when the directory or its lists are missing or
-  /// broken; std::invalid_argument naming groundtruth.txt when it is missing or a depth image
-  /// has no pose within max_pose_time_difference (naming its timestamp).
+  /// broken; std::invalid_argument naming groundtruth.txt when it is missing (unless
+  /// require_poses is false) or a depth image has no pose within
+  /// max_pose_time_difference (naming its timestamp).
   explicit TumSequenceSource(const std::string& directory, const TumSequenceOptions& options = {});
 
   /// \throws std::invalid_argument naming the file when an image is missing, not a PNG,
@@ -57,6 +61,8 @@ class TumSequenceSource : public FrameSource {
   [[nodiscard]] std::string describe() const override;
   /// Number of frames in the sequence.
   [[nodiscard]] std::size_t size() const { return entries_.size(); }
+  /// Whether the frames carry the sequence's own poses (groundtruth.txt).
+  [[nodiscard]] bool has_poses() const { return !poses_.empty(); }
 
  private:
   struct Entry {
