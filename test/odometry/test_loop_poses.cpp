@@ -97,6 +97,39 @@ TEST(LoopPoses, APoseOdometryCannotTellStopsTheCamera) {
   EXPECT_EQ(o.metrics.poses->unknown, unknown);
 }
 
+TEST(LoopPoses, TheOdometrysOwnSettingsReachIt) {
+  // odometry_NAME: the odometry's setting NAME. Asking for nearly every pixel
+  // fails every frame, the first included, and the camera never moves.
+  const EpisodeOutcome o =
+      run(sim::kDefaultScenario, {{"duration", "0.5"}, {"poses", "odometry"}, {"odometry_min_valid_fraction", "0.99"}});
+  ASSERT_TRUE(o.metrics.poses);
+  EXPECT_EQ(o.metrics.poses->unknown, static_cast<long>(o.steps.size()));
+  EXPECT_EQ(o.metrics.path_length, 0.0);
+  const EpisodeSetup s = resolve_episode(sim::load_scenario(sim::kDefaultScenario),
+                                         {{"odometry_keyframe", "false"}, {"odometry_mask_margin", "0.2"}});
+  const auto values = episode_settings_table().values(s);
+  const auto value = [&](const std::string& name) {
+    for (const auto& [n, v] : values) {
+      if (n == name) return v;
+    }
+    return std::string("?");
+  };
+  EXPECT_EQ(value("odometry_keyframe"), "false");
+  EXPECT_EQ(value("odometry_mask_margin"), "0.2");
+  EXPECT_EQ(value("odometry_mask"), "true");  // the odometry's default
+  // Errors name the setting; a combination the odometry refuses, with poses odometry.
+  const auto error = [](const std::vector<std::pair<std::string, std::string>>& settings) -> std::string {
+    try {
+      (void)resolve_episode(sim::load_scenario(sim::kDefaultScenario), settings);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(error({{"odometry_mask", "maybe"}}).find("odometry_mask"), std::string::npos);
+  EXPECT_NE(error({{"poses", "odometry"}, {"odometry_min_depth", "5"}}).find("min_depth"), std::string::npos);
+}
+
 TEST(LoopPoses, OdometryNeedsAFrontEnd) {
   const sim::Scenario scenario = sim::load_scenario(sim::kDefaultScenario);
   for (const auto& settings : std::vector<std::vector<std::pair<std::string, std::string>>>{

@@ -120,6 +120,31 @@ SettingsTable<EpisodeSetup> make_table() {
          "rgbd module; the renderer and the metrics keep the true pose); a frame whose pose odometry cannot tell "
          "stops the robot"},
         [](E& e, const std::string& v) { set_poses(e, v); }, [](const E& e) { return poses_word(e); });
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+  // The odometry's own settings, prefixed (mask, min_depth ... would clash);
+  // its method is setting poses'.
+  for (const auto& row : odometry::odometry_settings_table().rows()) {
+    if (row.doc.name == "odometry") continue;
+    const std::string name = "odometry_" + row.doc.name;
+    t.add({name, row.doc.type, row.doc.default_value, row.doc.unit, "poses odometry: " + row.doc.doc},
+          [name, inner = row.doc.name](E& e, const std::string& v) {
+            odometry::OdometrySettings check;
+            try {
+              odometry::odometry_settings_table().set(check, inner, v);
+            } catch (const std::invalid_argument& error) {
+              throw std::invalid_argument("setting '" + name + "': " + error.what());
+            }
+            const auto same = [&](const auto& kv) { return kv.first == inner; };
+            e.odometry.erase(std::remove_if(e.odometry.begin(), e.odometry.end(), same), e.odometry.end());
+            e.odometry.emplace_back(inner, v);
+          },
+          [get = row.get](const E& e) {
+            odometry::OdometrySettings o;
+            odometry::odometry_settings_table().apply(o, e.odometry);
+            return get(o);
+          });
+  }
+#endif
   t.add({"real_time", "bool", format_bool(d.real_time), "",
          "run the arm on ViSP's threaded simulator in wall-clock time (robot viper850 or afma6)"},
         [](E& e, const std::string& v) { e.real_time = parse_bool("real_time", v); },
@@ -291,6 +316,7 @@ PoseSource episode_pose_source(const EpisodeSetup& setup) {
 #ifdef OFV_LOOP_HAVE_ODOMETRY
   odometry::OdometrySettings settings;
   if (!setup.odometry_method.empty()) settings.method = odometry::parse_method("poses", setup.odometry_method);
+  odometry::odometry_settings_table().apply(settings, setup.odometry);
   return odometry::odometry_pose_source(settings);
 #else
   throw std::invalid_argument("setting poses = " + poses_word(setup) + " " + kNoOdometry);
@@ -349,6 +375,15 @@ EpisodeSetup resolve_episode(const sim::Scenario& scenario,
                                   " does not go with method = hindsight: the plan is followed from the true poses, "
                                   "without perception");
     }
+#ifdef OFV_LOOP_HAVE_ODOMETRY
+    odometry::OdometrySettings o;
+    odometry::odometry_settings_table().apply(o, s.odometry);
+    try {
+      odometry::validate(o);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("odometry settings (odometry_NAME): ") + e.what());
+    }
+#endif
   }
   if (s.real_time && s.robot == servo::RobotKind::Camera) {
     throw std::invalid_argument("setting 'real_time' needs robot viper850 or afma6 (ViSP's threaded simulators)");

@@ -98,6 +98,10 @@ struct EpisodeSetup {
   /// the odometry's default. (A word, not the odometry's enum: that
   /// component is optional.)
   std::string odometry_method;
+  /// With PoseOrigin::Odometry: the odometry's other settings as set
+  /// (settings `odometry_NAME`: NAME of ofv::odometry's table, and its value
+  /// as text), in the order set; the odometry's defaults for the others.
+  std::vector<std::pair<std::string, std::string>> odometry;
 };
 
 /**
