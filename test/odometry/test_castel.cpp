@@ -20,6 +20,7 @@
 //   build/bin/ofv_odometry_tests --gtest_filter='Castel.*'
 #include "ofv/odometry/evaluation.h"
 #include "ofv/odometry/odometry.h"
+#include "ofv/servo/target_pose.h"
 
 #include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/core/vpImage.h>
@@ -96,15 +97,6 @@ vpHomogeneousMatrix read_pose_vector(const std::string& file) {
   return vpHomogeneousMatrix(p);
 }
 
-Eigen::Isometry3d to_eigen(const vpHomogeneousMatrix& m) {
-  Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  for (unsigned r = 0; r < 3; ++r) {
-    for (unsigned c = 0; c < 3; ++c) e.linear()(r, c) = m[r][c];
-    e.translation()(r) = m[r][3];
-  }
-  return e;
-}
-
 double median(std::vector<double> x) {
   std::sort(x.begin(), x.end());
   return x.empty() ? 0.0 : x[x.size() / 2];
@@ -179,7 +171,7 @@ TEST(Castel, OdometryFollowsViSPsModelBasedTrackerOnARealRecording) {
     EXPECT_TRUE(r.status == OdometryStatus::Ok || r.status == OdometryStatus::FirstFrame)
         << "frame " << k << ": " << to_string(r.status);
     estimate.push_back({frame.timestamp, r.wMc});
-    reference.push_back({frame.timestamp, to_eigen(first_dMo * dMo.inverse())});
+    reference.push_back({frame.timestamp, servo::to_eigen(first_dMo * dMo.inverse())});
   }
   ASSERT_EQ(estimate.size(), 30U) << dir;
 
