@@ -268,12 +268,15 @@ void check_hindsight(const HindsightSettings& s, double r_sphere, double duratio
     throw std::invalid_argument("hindsight planner: duration and rate must be finite, got " + format_number(duration) +
                                 " s at " + format_number(rate) + " Hz");
   }
+  // A camera moves between views at most reach apart, or segment_steps x
+  // reach apart by a straight move.
   const double reach = s.max_speed * s.frames_per_step / rate;
-  if (s.spacing > reach) {
+  if (s.spacing > reach * s.segment_steps) {
     throw std::invalid_argument("setting 'hindsight_spacing' = " + format_number(s.spacing) +
-                                " m is more than the camera travels in one step (" + format_number(reach) +
-                                " m = max_linear_speed x hindsight_step / rate): it could never move; lower the "
-                                "spacing or raise hindsight_step");
+                                " m is more than the camera travels in hindsight_segment steps (" +
+                                format_number(reach * s.segment_steps) +
+                                " m = max_linear_speed x hindsight_step x hindsight_segment / rate): it could never "
+                                "move; lower the spacing or raise hindsight_step or hindsight_segment");
   }
   const double views = 4.0 * kPi * r_sphere * r_sphere / (s.spacing * s.spacing);
   if (views > kMaxViews) {

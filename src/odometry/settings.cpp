@@ -10,11 +10,13 @@ namespace {
 
 using S = OdometrySettings;
 
-/// A row for a number in (lo, hi] (or [lo, hi]) of the member `field`.
+/// A row for a number in (lo, hi] (or [lo, hi]) of the member `field`; its type documents the range.
 void number_row(SettingsTable<S>& t, const char* name, double S::*field, const char* unit, const char* doc,
                 double lo, double hi, bool lo_open) {
   const S d;
-  t.add({name, "number", format_number(d.*field), unit, doc},
+  const std::string type =
+      std::string("number in ") + (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) + "]";
+  t.add({name, type, format_number(d.*field), unit, doc},
         [=](S& s, const std::string& v) { s.*field = parse_number(name, v, lo, hi, lo_open); },
         [=](const S& s) { return format_number(s.*field); });
 }
@@ -64,7 +66,7 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                1.0, true);
     number_row(t, "min_depth", &S::min_depth, "m", "pixels nearer than this are not used", 0.0, 100.0, false);
     number_row(t, "max_depth", &S::max_depth, "m", "pixels farther than this are not used", 0.0, 100.0, true);
-    t.add({"iterations", "integer", std::to_string(d.iterations), "",
+    t.add({"iterations", "integer in [1, 1000]", std::to_string(d.iterations), "",
            "iterations at each of the 3 finer pyramid levels (1.5x at the coarsest; OpenCV's default 7)"},
           [](S& s, const std::string& v) { s.iterations = static_cast<int>(parse_integer("iterations", v, 1, 1000)); },
           [](const S& s) { return std::to_string(s.iterations); });

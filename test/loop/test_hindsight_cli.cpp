@@ -53,7 +53,7 @@ TEST(HindsightCli, OfvRunRefusesIt) {
 }
 
 TEST(HindsightCli, ASpacingTheCameraCannotCrossIsAUsageError) {
-  const CommandRun r = run("simulate dvd-one-hand --no-pictures --set method=hindsight --set hindsight_spacing=0.05 --out " +
+  const CommandRun r = run("simulate dvd-one-hand --no-pictures --set method=hindsight --set hindsight_spacing=0.06 --out " +
                            (fs::path(test::scratch_dir()) / "hindsight_bad").string());
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("hindsight_spacing"), std::string::npos) << r.err;

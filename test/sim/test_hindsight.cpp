@@ -123,8 +123,13 @@ TEST(Hindsight, BadSettingsAreRefusedByName) {
   HindsightSettings h;
   h.spacing = 0.0;
   EXPECT_NE(error(h).find("hindsight_spacing"), std::string::npos);
-  h.spacing = 0.02;
+  h.spacing = 0.06;  // more than 3 steps of 1.67 cm
   EXPECT_NE(error(h).find("could never move"), std::string::npos);
+  h.spacing = 0.02;  // by straight moves only
+  h.segment_steps = 1;
+  EXPECT_NE(error(h).find("could never move"), std::string::npos);
+  h.segment_steps = 3;
+  EXPECT_EQ(error(h), "no error");
   h.spacing = 0.001;
   EXPECT_NE(error(h).find("more than 100000"), std::string::npos);
   h = {};
