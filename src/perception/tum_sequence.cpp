@@ -123,16 +123,16 @@ TumSequenceSource::TumSequenceSource(const std::string& directory,
   for (const ListEntry& d : depth) entries_.push_back(Entry{d.time, d.file, nearest(rgb, d.time), nearest(labels, d.time)});
   if (fs::exists(dir / "object.txt")) objects_ = read_pose_file((dir / "object.txt").string());
   const std::string ground_truth = (dir / "groundtruth.txt").string();
-  if (!fs::exists(ground_truth)) {
-    if (options.require_poses) {
-      throw std::invalid_argument(ground_truth +
-                                  ": missing (the camera pose of each depth image; without it, poses from RGB-D "
-                                  "odometry: --poses odometry)");
-    }
-  } else {
-    poses_ = read_pose_file(ground_truth);
+  const bool has_ground_truth = fs::exists(ground_truth);
+  if (!has_ground_truth && options.require_poses) {
+    throw std::invalid_argument(ground_truth +
+                                ": missing (the camera pose of each depth image; without it, poses from RGB-D "
+                                "odometry: --poses odometry)");
   }
-  for (const Entry& e : poses_.empty() ? std::vector<Entry>{} : entries_) {
+  if (has_ground_truth) poses_ = read_pose_file(ground_truth);
+  // Every depth image has a pose when the file is there (an empty one included).
+  for (std::size_t k = 0; has_ground_truth && k < entries_.size(); ++k) {
+    const Entry& e = entries_[k];
     const auto after = std::lower_bound(poses_.begin(), poses_.end(), e.time,
                                         [](const StampedPose& p, double t) { return p.time < t; });
     double gap = std::numeric_limits<double>::infinity();
