@@ -66,6 +66,24 @@ bool same(const CameraIntrinsics& a, const CameraIntrinsics& b) {
          a.cy == b.cy;
 }
 
+/// The whole factor that brings `width` within `max_width` (1: none, or max_width 0).
+int reduction(int width, int max_width) {
+  return max_width > 0 && width > max_width ? (width + max_width - 1) / max_width : 1;
+}
+
+/// The intrinsics of every `factor`-th pixel of every `factor`-th row
+/// (pixel u of the result is pixel factor·u of the frame).
+CameraIntrinsics reduced(const CameraIntrinsics& k, int factor) {
+  CameraIntrinsics r = k;
+  r.width = k.width / factor;
+  r.height = k.height / factor;
+  r.fx = k.fx / factor;
+  r.fy = k.fy / factor;
+  r.cx = k.cx / factor;
+  r.cy = k.cy / factor;
+  return r;
+}
+
 /// The rotation's angle [rad].
 double angle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 
@@ -74,7 +92,9 @@ double angle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 struct Odometry::Impl {
   OdometrySettings settings;
   cv::Ptr<cv::rgbd::Odometry> odometry;
-  CameraIntrinsics intrinsics;
+  CameraIntrinsics input;       // the frames' (the first frame's)
+  int factor = 1;               // OdometrySettings::max_width: matched at 1/factor of the frames' size
+  CameraIntrinsics intrinsics;  // of the frames as matched
   bool started = false;
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  // the last good pose
   Eigen::Isometry3d wMk = Eigen::Isometry3d::Identity();  // the reference frame's pose
@@ -91,8 +111,8 @@ struct Odometry::Impl {
   /// mask of the pixels used, grey image for the photometric methods.
   cv::Ptr<cv::rgbd::OdometryFrame> convert(const RgbdFrame& frame, std::optional<double> object_depth,
                                            OdometryDiagnostics& d) const {
-    const int w = frame.intrinsics.width;
-    const int h = frame.intrinsics.height;
+    const int w = intrinsics.width;
+    const int h = intrinsics.height;
     cv::Mat depth(h, w, CV_32FC1);
     cv::Mat mask(h, w, CV_8UC1);
     const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -104,7 +124,7 @@ struct Odometry::Impl {
       auto* drow = depth.ptr<float>(v);
       auto* mrow = mask.ptr<std::uint8_t>(v);
       for (int u = 0; u < w; ++u) {
-        const float z = frame.depth[frame.index(u, v)];
+        const float z = frame.depth[frame.index(factor * u, factor * v)];
         const bool valid = z >= settings.min_depth && z <= settings.max_depth;  // NaN fails
         drow[u] = valid ? z : nan;
         const bool hidden = valid && masking && z < nearest;
@@ -118,9 +138,13 @@ struct Odometry::Impl {
     d.masked_fraction = static_cast<double>(masked) / pixels;
     cv::Mat grey;
     if (needs_colour()) {
-      if (frame.rgb.size() == static_cast<std::size_t>(w) * h * 3) {
-        const cv::Mat rgb(h, w, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+      const int fw = frame.intrinsics.width;
+      const int fh = frame.intrinsics.height;
+      if (frame.rgb.size() == static_cast<std::size_t>(fw) * fh * 3) {
+        const cv::Mat rgb(fh, fw, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
         cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+        // Pixel factor·u, as the depth (nearest: pixel floor(u·fw/w)).
+        if (factor > 1) cv::resize(grey, grey, cv::Size(w, h), 0.0, 0.0, cv::INTER_NEAREST);
       } else {
         grey = cv::Mat::zeros(h, w, CV_8UC1);
       }
@@ -201,7 +225,7 @@ OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> obje
                                 " values, its intrinsics say " + std::to_string(k.width) + "x" +
                                 std::to_string(k.height));
   }
-  if (m.started && !same(k, m.intrinsics)) {
+  if (m.started && !same(k, m.input)) {
     throw std::invalid_argument("odometry: the frame's intrinsics differ from the first frame's");
   }
   OdometryResult result;
@@ -214,8 +238,10 @@ OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> obje
   };
   OdometryDiagnostics& d = result.diagnostics;
   if (!m.started) {
-    m.intrinsics = k;
-    m.odometry = make_odometry(m.settings, k);
+    m.input = k;
+    m.factor = reduction(k.width, m.settings.max_width);
+    m.intrinsics = reduced(k, m.factor);
+    m.odometry = make_odometry(m.settings, m.intrinsics);
   }
   cv::Ptr<cv::rgbd::OdometryFrame> current = m.convert(frame, object_depth, d);
   if (!m.started) {

@@ -72,6 +72,11 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
           [](const S& s) { return std::to_string(s.iterations); });
     number_row(t, "max_points_part", &S::max_points_part, "",
                "share of the pixels the ICP and RGB-D methods sample (OpenCV's maxPointsPart)", 0.0, 1.0, true);
+    t.add({"max_width", "integer in [0, 100000]", std::to_string(d.max_width), "px",
+           "frames wider than this are matched at the whole fraction of their size that brings them within it, "
+           "every 2nd (3rd, ...) pixel of every 2nd row (0: at their own size)"},
+          [](S& s, const std::string& v) { s.max_width = static_cast<int>(parse_integer("max_width", v, 0, 100000)); },
+          [](const S& s) { return std::to_string(s.max_width); });
     bool_row(t, "mask", &S::mask,
              "leave out pixels nearer than the object's depth in the previous frame minus mask_margin (hands, "
              "occluders)");

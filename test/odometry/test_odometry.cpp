@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 
 namespace ofv::odometry {
 namespace {
@@ -80,6 +82,38 @@ TEST(Odometry, RecoversOneDegreeRotation) {
 TEST(Odometry, OtherIcpMethodsRecoverTranslation) {
   expect_recovers(OdometryMethod::RgbdIcp, Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)));
   expect_recovers(OdometryMethod::FastIcp, Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)));
+}
+
+TEST(Odometry, WideFramesAreMatchedAtAWholeFractionOfTheirSize) {
+  // 640x480 frames: matched at 320x240 by default (every 2nd pixel of every
+  // 2nd row), at their own size with max_width 0. Both recover a 1 cm step
+  // and use the same share of the pixels.
+  Scene scene("dvd-static");
+  const CameraIntrinsics wide;  // 640x480, f 615 px
+  const auto frame = [&](const Eigen::Isometry3d& cMc2, long index) {
+    return scene.renderer.render(scene.scenario.wMc_start * cMc2, index, wide, true).frame;
+  };
+  const RgbdFrame first = frame(Eigen::Isometry3d::Identity(), 0);
+  const RgbdFrame second = frame(Eigen::Isometry3d(Eigen::Translation3d(0.01, 0.0, 0.0)), 1);
+  std::vector<double> valid;
+  for (const int max_width : {320, 0}) {
+    OdometrySettings s;
+    s.max_width = max_width;
+    s.iterations = 15;  // as expect_recovers(): 1 cm in one frame
+    Odometry odometry(s);
+    const OdometryResult r0 = odometry.step(first);
+    ASSERT_EQ(r0.status, OdometryStatus::FirstFrame);
+    valid.push_back(r0.diagnostics.valid_fraction);
+    const OdometryResult r1 = odometry.step(second);
+    ASSERT_EQ(r1.status, OdometryStatus::Ok) << "max_width " << max_width;
+    EXPECT_LT(error(r1.wMc, second.wMc).first, kTranslationTolerance) << "max_width " << max_width;
+    EXPECT_LT(error(r1.wMc, second.wMc).second, kRotationTolerance) << "max_width " << max_width;
+  }
+  EXPECT_NEAR(valid[0], valid[1], 0.01);
+  // A frame of another size is refused, whatever size they are matched at.
+  Odometry odometry;
+  (void)odometry.step(first);
+  EXPECT_THROW((void)odometry.step(scene.frame(Eigen::Isometry3d::Identity(), 1)), std::invalid_argument);
 }
 
 TEST(Odometry, StartsAtTheFirstFramesPoseAndComposes) {

@@ -81,6 +81,11 @@ struct OdometrySettings {
   double max_depth = 4.0;        ///< pixels farther than this are not used [m]
   int iterations = 7;  ///< ICP iterations at each of the 3 finer pyramid levels, 1.5x at the coarsest (OpenCV's default 7)
   double max_points_part = 0.07;  ///< share of the pixels OpenCV samples (ICP, RGB-D; OpenCV's maxPointsPart)
+  /// Frames wider than this [px] are matched at a whole fraction of their
+  /// size, every 2nd (3rd, ...) pixel of every 2nd row, the smallest that
+  /// brings them within it (0: at their own size). The cost goes with the
+  /// pixels: a 640x480 sensor at 320x240 costs about a quarter.
+  int max_width = 320;
   bool mask = true;  ///< leave out pixels nearer than the object's depth minus mask_margin, when the caller gives it
   double mask_margin = 0.10;  ///< [m] see `mask`: the hands and occluders in front of the object
 };
