@@ -33,17 +33,20 @@ cv::Ptr<cv::rgbd::Odometry> make_odometry(const OdometrySettings& s, const Camer
   // (max_translation, max_rotation) makes it Implausible, so OpenCV's is lifted.
   constexpr double kUnbounded = 1e3;
   // OpenCV's default is 7, 7, 7, 10 from the finest level to the coarsest.
+  // The ICP methods do finest_iterations at the finest.
   const int n = s.iterations;
   const std::vector<int> iterations = {n, n, n, n + n / 2};
+  std::vector<int> icp = iterations;
+  icp[0] = s.finest_iterations;
   switch (s.method) {
     case OdometryMethod::Icp: {
-      auto o = cv::rgbd::ICPOdometry::create(K, min_depth, max_depth, diff, part, iterations);
+      auto o = cv::rgbd::ICPOdometry::create(K, min_depth, max_depth, diff, part, icp);
       o->setMaxTranslation(kUnbounded);
       o->setMaxRotation(kUnbounded);
       return o;
     }
     case OdometryMethod::RgbdIcp: {
-      auto o = cv::rgbd::RgbdICPOdometry::create(K, min_depth, max_depth, diff, part, iterations);
+      auto o = cv::rgbd::RgbdICPOdometry::create(K, min_depth, max_depth, diff, part, icp);
       o->setMaxTranslation(kUnbounded);
       o->setMaxRotation(kUnbounded);
       return o;

@@ -67,9 +67,17 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
     number_row(t, "min_depth", &S::min_depth, "m", "pixels nearer than this are not used", 0.0, 100.0, false);
     number_row(t, "max_depth", &S::max_depth, "m", "pixels farther than this are not used", 0.0, 100.0, true);
     t.add({"iterations", "integer in [1, 1000]", std::to_string(d.iterations), "",
-           "iterations at each of the 3 finer pyramid levels (1.5x at the coarsest; OpenCV's default 7)"},
+           "iterations at the 2nd and 3rd pyramid levels (at the finest too but for icp and rgbd_icp: "
+           "finest_iterations), 1.5x at the 4th, the coarsest (OpenCV's default 7)"},
           [](S& s, const std::string& v) { s.iterations = static_cast<int>(parse_integer("iterations", v, 1, 1000)); },
           [](const S& s) { return std::to_string(s.iterations); });
+    t.add({"finest_iterations", "integer in [1, 1000]", std::to_string(d.finest_iterations), "",
+           "iterations of icp and rgbd_icp at the finest pyramid level, the frame as matched: the costliest, a "
+           "pass over every pixel each (OpenCV's default 7; more fit the noise: docs/perception.md)"},
+          [](S& s, const std::string& v) {
+            s.finest_iterations = static_cast<int>(parse_integer("finest_iterations", v, 1, 1000));
+          },
+          [](const S& s) { return std::to_string(s.finest_iterations); });
     number_row(t, "max_points_part", &S::max_points_part, "",
                "share of the pixels the ICP and RGB-D methods sample (OpenCV's maxPointsPart)", 0.0, 1.0, true);
     t.add({"max_width", "integer in [0, 100000]", std::to_string(d.max_width), "px",
