@@ -69,9 +69,11 @@ bool same(const CameraIntrinsics& a, const CameraIntrinsics& b) {
          a.cy == b.cy;
 }
 
-/// The whole factor that brings `width` within `max_width` (1: none, or max_width 0).
-int reduction(int width, int max_width) {
-  return max_width > 0 && width > max_width ? (width + max_width - 1) / max_width : 1;
+/// The whole factor that brings the width within `max_width` (1: none, or
+/// max_width 0), leaving at least one row.
+int reduction(const CameraIntrinsics& k, int max_width) {
+  const int f = max_width > 0 && k.width > max_width ? (k.width + max_width - 1) / max_width : 1;
+  return std::max(1, std::min(f, k.height));
 }
 
 /// The intrinsics of every `factor`-th pixel of every `factor`-th row
@@ -242,7 +244,7 @@ OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> obje
   OdometryDiagnostics& d = result.diagnostics;
   if (!m.started) {
     m.input = k;
-    m.factor = reduction(k.width, m.settings.max_width);
+    m.factor = reduction(k, m.settings.max_width);
     m.intrinsics = reduced(k, m.factor);
     m.odometry = make_odometry(m.settings, m.intrinsics);
   }
