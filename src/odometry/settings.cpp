@@ -21,6 +21,16 @@ void number_row(SettingsTable<S>& t, const char* name, double S::*field, const c
         [=](const S& s) { return format_number(s.*field); });
 }
 
+/// A row for a whole number in [lo, hi] of the member `field`; its type documents the range.
+void integer_row(SettingsTable<S>& t, const char* name, int S::*field, const char* unit, const char* doc, long lo,
+                 long hi) {
+  const S d;
+  const std::string type = "integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  t.add({name, type, std::to_string(d.*field), unit, doc},
+        [=](S& s, const std::string& v) { s.*field = static_cast<int>(parse_integer(name, v, lo, hi)); },
+        [=](const S& s) { return std::to_string(s.*field); });
+}
+
 void bool_row(SettingsTable<S>& t, const char* name, bool S::*field, const char* doc) {
   const S d;
   t.add({name, "bool", format_bool(d.*field), "", doc},
@@ -66,25 +76,20 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                1.0, true);
     number_row(t, "min_depth", &S::min_depth, "m", "pixels nearer than this are not used", 0.0, 100.0, false);
     number_row(t, "max_depth", &S::max_depth, "m", "pixels farther than this are not used", 0.0, 100.0, true);
-    t.add({"iterations", "integer in [1, 1000]", std::to_string(d.iterations), "",
-           "iterations at the 2nd and 3rd pyramid levels (at the finest too but for icp and rgbd_icp: "
-           "finest_iterations), 1.5x at the 4th, the coarsest (OpenCV's default 7)"},
-          [](S& s, const std::string& v) { s.iterations = static_cast<int>(parse_integer("iterations", v, 1, 1000)); },
-          [](const S& s) { return std::to_string(s.iterations); });
-    t.add({"finest_iterations", "integer in [1, 1000]", std::to_string(d.finest_iterations), "",
-           "iterations of icp and rgbd_icp at the finest pyramid level, the frame as matched: the costliest, a "
-           "pass over every pixel each (OpenCV's default 7; more fit the noise: docs/perception.md)"},
-          [](S& s, const std::string& v) {
-            s.finest_iterations = static_cast<int>(parse_integer("finest_iterations", v, 1, 1000));
-          },
-          [](const S& s) { return std::to_string(s.finest_iterations); });
+    integer_row(t, "iterations", &S::iterations, "",
+                "iterations at the 2nd and 3rd pyramid levels (at the finest too but for icp and rgbd_icp: "
+                "finest_iterations), 1.5x at the 4th, the coarsest (OpenCV's default 7)",
+                1, 1000);
+    integer_row(t, "finest_iterations", &S::finest_iterations, "",
+                "iterations of icp and rgbd_icp at the finest pyramid level, the frame as matched: the costliest, a "
+                "pass over every pixel each (OpenCV's default 7; more fit the noise: docs/perception.md)",
+                1, 1000);
     number_row(t, "max_points_part", &S::max_points_part, "",
                "share of the pixels the ICP and RGB-D methods sample (OpenCV's maxPointsPart)", 0.0, 1.0, true);
-    t.add({"max_width", "integer in [0, 100000]", std::to_string(d.max_width), "px",
-           "frames wider than this are matched at the whole fraction of their size that brings them within it, "
-           "every 2nd (3rd, ...) pixel of every 2nd row (0: at their own size)"},
-          [](S& s, const std::string& v) { s.max_width = static_cast<int>(parse_integer("max_width", v, 0, 100000)); },
-          [](const S& s) { return std::to_string(s.max_width); });
+    integer_row(t, "max_width", &S::max_width, "px",
+                "frames wider than this are matched at the whole fraction of their size that brings them within it, "
+                "every 2nd (3rd, ...) pixel of every 2nd row (0: at their own size)",
+                0, 100000);
     bool_row(t, "mask", &S::mask,
              "leave out pixels nearer than the object's depth in the previous frame minus mask_margin (hands, "
              "occluders)");
