@@ -32,12 +32,11 @@ cv::Ptr<cv::rgbd::Odometry> make_odometry(const OdometrySettings& s, const Camer
   // OpenCV's own motion bound turns a large motion into a failure; ours
   // (max_translation, max_rotation) makes it Implausible, so OpenCV's is lifted.
   constexpr double kUnbounded = 1e3;
-  // OpenCV's default is 7, 7, 7, 10 from the finest level to the coarsest.
-  // The ICP methods do finest_iterations at the finest.
+  // OpenCV's default is 7, 7, 7, 10 from the finest level to the coarsest;
+  // the ICP methods do finest_iterations at the finest.
   const int n = s.iterations;
   const std::vector<int> iterations = {n, n, n, n + n / 2};
-  std::vector<int> icp = iterations;
-  icp[0] = s.finest_iterations;
+  const std::vector<int> icp = {s.finest_iterations, n, n, n + n / 2};
   switch (s.method) {
     case OdometryMethod::Icp: {
       auto o = cv::rgbd::ICPOdometry::create(K, min_depth, max_depth, diff, part, icp);
