@@ -19,6 +19,12 @@ namespace ofv::perception {
 
 using detail::chroma;
 
+namespace {
+/// A surface facing a camera at less than this cosine (17 degrees from
+/// edge-on) gives it too few and too noisy pixels to be told apart.
+constexpr double kGrazing = 0.3;
+}  // namespace
+
 std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
   const std::size_t n = r.supervoxels.size();
   const TrackingSettings& t = settings.tracking;
@@ -59,60 +65,83 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   const TrackingSettings& t = settings.tracking;
   const std::size_t n = r.supervoxels.size();
   const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
-  // A voxel the previous frame could not see (in its image, behind a
-  // surface nearer its camera by more than max_motion) is the object's when
-  // that surface was the object: a remembered voxel of the voxel's
-  // chromaticity (its own fold hid it). Voxel by voxel, so that a hand
-  // never joins through a supervoxel that mixes it with the object.
+  // Surface the previous frame could not show, voxel by voxel (so that a
+  // hand never joins through a supervoxel that mixes it with the object):
+  // - hidden: behind a surface nearer its camera by more than max_motion.
+  //   The voxel is the object's when that surface was the object (a
+  //   remembered voxel of the voxel's chromaticity: its own fold hid it).
+  // - unseen: beyond its image, or on a surface that faced its camera at
+  //   less than kGrazing (seen edge-on or from behind: the top of a box the
+  //   camera rises over, a part the first image cut). Nothing tells whose
+  //   it is but what it touches: the object's when its component (below)
+  //   touches the object through a neighbour of the object's colour.
   const Eigen::Isometry3d cMw = previous.wMc.inverse();
+  const Eigen::Vector3d eye = previous.wMc.translation();
   const CameraIntrinsics& k = previous.intrinsics;
-  std::vector<int> seen_before(n, 0);  // voxels the previous frame showed where they are
+  std::vector<int> seen_before(n, 0);  // voxels the previous frame showed where they are, not edge-on
   std::vector<int> revealed(n, 0);     // voxels the object hid from it
-  std::vector<char> voxel_revealed_here(r.voxels.size(), 0);
+  std::vector<int> unseen(n, 0);       // voxels beyond its image or edge-on to it
+  std::vector<char> voxel_state(r.voxels.size(), 0);  // 1 hidden by the object, 2 unseen
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    const SupervoxelInfo& s = r.supervoxels[owner];
     if (object[owner] || plane_voxel(r.voxels[i], sv.colours[i])) continue;
-    const auto l = detail::look(previous, cMw, r.voxels[i].cast<double>());
-    if (!l || !l->measured()) continue;
-    const double d = l->observed;
-    if (std::abs(d - l->z) <= t.max_motion) ++seen_before[owner];
-    if (!(d < l->z - t.max_motion)) continue;
-    const Eigen::Vector3f hider =
-        (previous.wMc * Eigen::Vector3d((l->u - k.cx) * d / k.fx, (l->v - k.cy) * d / k.fy, d)).cast<float>();
-    if (remembered_near(hider, res, chroma(sv.colours[i]))) {
-      voxel_revealed_here[i] = 1;
-      ++revealed[owner];
+    const Eigen::Vector3d p = r.voxels[i].cast<double>();
+    const auto l = detail::look(previous, cMw, p);
+    if (l && !l->measured()) continue;  // a drop-out tells nothing
+    const double d = l ? static_cast<double>(l->observed) : 0.0;
+    if (l && d < l->z - t.max_motion) {
+      const Eigen::Vector3f hider =
+          (previous.wMc * Eigen::Vector3d((l->u - k.cx) * d / k.fx, (l->v - k.cy) * d / k.fy, d)).cast<float>();
+      if (remembered_near(hider, res, chroma(sv.colours[i]))) {
+        voxel_state[i] = 1;
+        ++revealed[owner];
+      }
+      continue;
+    }
+    const bool edge_on = s.normal_valid && s.normal.dot((eye - p).normalized()) < kGrazing;
+    if (!l || edge_on) {
+      voxel_state[i] = 2;
+      ++unseen[owner];
+    } else if (std::abs(d - l->z) <= t.max_motion) {
+      ++seen_before[owner];
     }
   }
-  if (std::none_of(revealed.begin(), revealed.end(), [](int c) { return c > 0; })) return;
-  // A supervoxel joins when its revealed voxels and those near the memory
-  // make min_near_fraction of it; the revealed voxels of one that does not
-  // yet (revealed a strip at a time) are remembered, so that it joins once
+  const auto any = [](const std::vector<int>& v) { return std::any_of(v.begin(), v.end(), [](int c) { return c > 0; }); };
+  if (!any(revealed) && !any(unseen)) return;
+  // A supervoxel joins when its revealed voxels (and its unseen ones, when
+  // its component touches the object) and those near the memory make
+  // min_near_fraction of it; the revealed voxels of one that does not yet
+  // (revealed a strip at a time) are remembered, so that it joins once
   // enough of it is. Ambiguous, and left out: one linked, through
   // neighbours of one chromaticity that are not the object's, to a surface
   // of that colour the previous frame showed (most of its voxels) that is
   // not the object's (none near the memory): a distractor whose side the
-  // object hid could be either's. Neighbours: two voxels within R_adj
-  // (eq. 1's distance, here between voxels, not centroids: a strip revealed
-  // along a distractor's edge, seen grazing, is a broken line of voxels
-  // whose centroids lie farther than R_adj from the part it continues).
+  // object hid could be either's, and a hand of the object's colour that
+  // touches it is one. Neighbours: two voxels within R_adj (eq. 1's
+  // distance, here between voxels, not centroids: a strip revealed along a
+  // distractor's edge, seen grazing, is a broken line of voxels whose
+  // centroids lie farther than R_adj from the part it continues).
   const auto alike = [&](std::size_t x, std::size_t y) {
     return detail::alike(r.supervoxels[x].colour, r.supervoxels[y].colour, t.max_chroma_distance);
   };
   const auto candidate = [&](std::size_t j) { return !object[j] && !on_plane(r.supervoxels[j]); };
-  contacts.build(r, settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution, candidate);
+  contacts.build(r, settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution,
+                 [&](std::size_t j) { return !on_plane(r.supervoxels[j]); });
   const auto seen_not_object = [&](std::size_t j) {
     return 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0;
   };
-  // From each revealed supervoxel, its component (of candidates linked to
-  // alike neighbours); a component is searched once.
+  // From each revealed or unseen supervoxel, its component (of candidates
+  // linked to alike neighbours); a component is searched once.
   std::vector<int> component(n, -1);
   std::vector<char> component_ambiguous;
+  std::vector<char> component_touches;  // linked to an object supervoxel of its colour
   std::vector<std::size_t> open;
   for (std::size_t j = 0; j < n; ++j) {
-    if (revealed[j] == 0 || component[j] >= 0 || !candidate(j)) continue;
+    if ((revealed[j] == 0 && unseen[j] == 0) || component[j] >= 0 || !candidate(j)) continue;
     const int id = static_cast<int>(component_ambiguous.size());
     bool ambiguous = false;
+    bool touches = false;
     component[j] = id;
     open.assign(1, j);
     while (!open.empty()) {
@@ -120,23 +149,32 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
       open.pop_back();
       ambiguous = ambiguous || seen_not_object(x);
       contacts.for_each(x, [&](std::size_t y) {
-        if (component[y] < 0 && alike(x, y)) {
+        if (!alike(x, y)) return;
+        if (object[y]) {
+          touches = true;
+        } else if (component[y] < 0) {
           component[y] = id;
           open.push_back(y);
         }
       });
     }
     component_ambiguous.push_back(ambiguous ? 1 : 0);
+    component_touches.push_back(touches ? 1 : 0);
   }
   std::vector<char> reached(n, 0);
+  std::vector<char> counts_unseen(n, 0);
   for (std::size_t j = 0; j < n; ++j) {
-    if (revealed[j] == 0 || !candidate(j) || component_ambiguous[static_cast<std::size_t>(component[j])]) continue;
+    if ((revealed[j] == 0 && unseen[j] == 0) || !candidate(j)) continue;
+    const auto id = static_cast<std::size_t>(component[j]);
+    if (component_ambiguous[id]) continue;
     reached[j] = 1;
-    object[j] = static_cast<double>(revealed[j] + near[j]) >=
-                t.min_near_fraction * static_cast<double>(r.supervoxels[j].voxel_count);
+    counts_unseen[j] = component_touches[id];
+    const int counted = revealed[j] + near[j] + (counts_unseen[j] ? unseen[j] : 0);
+    object[j] = static_cast<double>(counted) >= t.min_near_fraction * static_cast<double>(r.supervoxels[j].voxel_count);
   }
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    voxel_revealed[i] = voxel_revealed_here[i] && reached[static_cast<std::size_t>(r.voxel_owner[i])] ? 1 : 0;
+    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    voxel_revealed[i] = reached[owner] && (voxel_state[i] == 1 || (voxel_state[i] == 2 && counts_unseen[owner])) ? 1 : 0;
   }
 }
 

@@ -54,9 +54,9 @@ const SettingsTable<PerceptionSettings>& perception_settings_table() {
           [](P& p, const std::string& v) { p.behind_occluders = parse_bool("behind_occluders", v); },
           [](const P& p) { return format_bool(p.behind_occluders); });
     t.add({"grow_revealed", "bool", format_bool(d.tracking.grow_revealed), "",
-           "the front end (perception full): surface the object itself hid (its own fold) joins the object when it "
-           "comes into view, however far from what was seen (false: only what lies within max_motion of the "
-           "remembered object)"},
+           "the front end (perception full): surface that comes into view from behind the object (its own fold), "
+           "from beyond the previous image or from edge-on joins the object, however far from what was seen "
+           "(false: only what lies within max_motion of the remembered object)"},
           [](P& p, const std::string& v) { p.tracking.grow_revealed = parse_bool("grow_revealed", v); },
           [](const P& p) { return format_bool(p.tracking.grow_revealed); });
     t.add({"holder_body", "bool", format_bool(d.holder_body), "",

@@ -485,6 +485,92 @@ TEST(Perception, DistractorOfTheObjectsColourStaysOutAsTheObjectRevealsIt) {
   }
 }
 
+/// Of the voxels inside `box` (centre, half size), how many there are and
+/// how many are in object supervoxels.
+std::pair<int, int> voxels_in(const perception::PerceptionResult& r, const Eigen::Vector3d& centre,
+                              const Eigen::Vector3d& half) {
+  int seen = 0;
+  int object = 0;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (((r.voxels[i].cast<double>() - centre).cwiseAbs() - half).maxCoeff() > 0.0) continue;
+    ++seen;
+    object += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
+  }
+  return {seen, object};
+}
+
+TEST(Perception, AFaceTurningIntoViewJoinsTheObject) {
+  // A shoe box 12 cm tall, first seen from 1 cm above its top: the top is
+  // edge-on. The camera rises 2.65 cm a frame and the top turns into view,
+  // farther from the front edge than max_motion: the surface the previous
+  // frame saw edge-on and that touches the object through its colour is
+  // the object's (grow_revealed); without it the top joins only as
+  // tracking reaches it, max_motion a frame, an occluder meanwhile.
+  const Eigen::Vector3d centre(0.0, 0.0, 0.06);
+  test::SyntheticScene scene;
+  scene.shapes.push_back(test::make_box({0.0, 0.0, -0.02}, {1.6, 1.6, 0.04}, {150, 110, 70}, kTable));
+  scene.shapes.push_back(test::make_box(centre, {0.30, 0.18, 0.12}, {200, 60, 40}, kObject));
+  const Eigen::Vector3d top(0.0, 0.0, 0.1175);  // the top's voxels: 5 mm under it, 5 mm inside its sides
+  const Eigen::Vector3d top_half(0.145, 0.085, 0.0075);
+  perception::PerceptionSettings on;
+  on.tracking.grow_revealed = true;
+  perception::PerceptionSettings off = on;
+  off.tracking.grow_revealed = false;
+  perception::Perception grow{on};
+  perception::Perception stay{off};
+  for (int k = 0; k <= 8; ++k) {
+    const Eigen::Isometry3d wMc =
+        test::look_at(Eigen::Vector3d(0.0, -0.5, 0.13 + 0.0265 * k), Eigen::Vector3d(0.0, 0.0, 0.09));
+    Frame f = render(scene, wMc, 320);
+    test::add_depth_noise(f.frame, 11u + static_cast<unsigned>(k));
+    const perception::PerceptionResult rg = grow.process(f.frame);
+    const perception::PerceptionResult rs = stay.process(f.frame);
+    ASSERT_NE(rg.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rg.message;
+    ASSERT_NE(rs.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rs.message;
+    const auto [seen, joined] = voxels_in(rg, top, top_half);
+    const auto [seen_off, joined_off] = voxels_in(rs, top, top_half);
+    if (k < 4) continue;  // the top at 17 degrees or more from edge-on from frame 3
+    ASSERT_GE(seen, 100) << "frame " << k << ": the camera does not see the top";
+    EXPECT_GE(joined, seen * 95 / 100) << "frame " << k << ": " << joined << " of the top's " << seen << " voxels";
+    if (k == 4) {
+      EXPECT_LE(joined_off, seen_off * 3 / 4) << joined_off << " of " << seen_off;
+    }
+  }
+}
+
+TEST(Perception, ThePartBeyondTheFirstImageJoinsTheObjectAsItComesIn) {
+  // The first image cuts the case: its right third lies beyond the border.
+  // The camera turns towards it, 1.5 cm of its aim a frame: the part that
+  // comes in from beyond the previous image and touches the object through
+  // its colour is the object's, not an occluder beside it.
+  perception::PerceptionSettings settings;
+  settings.tracking.grow_revealed = true;
+  settings.selection.mode = perception::ObjectSelection::Mode::Box;  // as a user points it out
+  settings.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.12, -0.03, 0.005), Eigen::Vector3d(0.12, 0.03, 0.16));
+  perception::Perception perception{settings};
+  const Eigen::Vector3d case_half(0.095, 0.0075, 0.0675);
+  int first_seen = 0;
+  for (int k = 0; k <= 6; ++k) {
+    const Eigen::Isometry3d wMc = test::look_at(Eigen::Vector3d(-0.25, -0.45, 0.20),
+                                                kCaseCentre + Eigen::Vector3d(-0.25 + 0.015 * k, 0.0, 0.0));
+    Frame f = render(test::table_and_case(), wMc, 320);
+    test::add_depth_noise(f.frame, 3u + static_cast<unsigned>(k));
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << r.message;
+    // The case's voxels but those at its foot, within a voxel of the table.
+    const auto [seen, joined] = voxels_in(r, kCaseCentre + Eigen::Vector3d(0.0, 0.0, 0.004),
+                                          case_half + Eigen::Vector3d(0.004, 0.004, -0.004));
+    if (k == 0) {
+      first_seen = seen;
+      continue;
+    }
+    EXPECT_GE(joined, seen * 97 / 100) << "frame " << k << ": " << joined << " of the case's " << seen << " voxels";
+    if (k == 6) {
+      EXPECT_LE(first_seen, seen * 3 / 4) << "the first image shows most of the case";
+    }
+  }
+}
+
 /// Largest distance of the problem's hidden vertices (its last
 /// counts.hidden_vertices columns) from the case, the box of `centre` [m].
 double hidden_vertices_off_case(const perception::PerceptionResult& r, const Eigen::Vector3d& centre) {

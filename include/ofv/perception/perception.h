@@ -119,8 +119,12 @@ struct TrackingSettings {
   /// its colour to a surface of that colour seen before and not the
   /// object's (a distractor whose side the object hid could be either's);
   /// the counted voxels of one that does not yet are remembered, so that it
-  /// joins once enough of it is. false: only what lies within max_motion of
-  /// the remembered object (the paper's assumption 2).
+  /// joins once enough of it is. Surface the previous frame could not show
+  /// otherwise — beyond its image (an object the first image cut) or facing
+  /// its camera at less than 17 degrees from edge-on (the top of a box the
+  /// camera rises over) — counts the same way when its supervoxel is linked
+  /// through surface of its colour to the object. false: only what lies
+  /// within max_motion of the remembered object (the paper's assumption 2).
   bool grow_revealed = true;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
   /// points) inlier distance [m]. Supervoxels on that plane (centroid within
