@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -13,6 +14,12 @@
 namespace ofv::perception {
 
 namespace {
+
+/// How far the object must have moved with a body touching it before
+/// taken_by_hand() tells a grip from a touch [m]: well above the drift of
+/// the object's estimated motion over a few seconds (about half a
+/// millimetre a frame on a still object).
+constexpr float kGripTravel = 0.02f;
 
 /// C, the mean of `points`, and their principal axes (columns, largest
 /// variance first, right-handed).
@@ -111,13 +118,16 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
   // frames find it again inside the box near where it was (within
   // max_motion, moved with the object); from there its body grows through
   // supervoxels in contact (contact_distance, voxel to voxel) and of its
-  // colour, in the sphere, not of the support plane. A hand that comes to
+  // colour, in the sphere, not of the support plane. A body that comes to
   // touch the object later is interacting where it touches, by the paper's
-  // rule, and an occluder beyond: it may stand in front of the object (a
-  // hand over a cloth's fold), which a holder seldom does.
+  // rule, and an occluder beyond (a hand over a cloth's fold), until it has
+  // moved with the object (taken_by_hand()): then it is the holder.
   const std::size_t n = r.supervoxels.size();
   const bool first = r.status == TrackingStatus::Initialised;
-  if (first) holder.clear();
+  if (first) {
+    holder.clear();
+    grip.clear();
+  }
   const auto radius = static_cast<float>(settings.tracking.max_motion);
   holder_grid.build(holder, radius);
   std::vector<char> body(n, 0);
@@ -140,19 +150,35 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
     const SupervoxelInfo& s = r.supervoxels[j];
     return !object[j] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere;
   };
-  if (!open.empty()) contacts.build(r, settings.contact_distance, candidate);
-  while (!open.empty()) {
-    const std::size_t x = open.back();
-    open.pop_back();
-    contacts.for_each(x, [&](std::size_t y) {
-      if (!body[y] && detail::alike(r.supervoxels[x].colour, r.supervoxels[y].colour,
+  contacts.build(r, settings.contact_distance, candidate);
+  // Grows `in` from the supervoxels in `open` through those in contact and of their colour.
+  const auto grow = [&](std::vector<char>& in) {
+    while (!open.empty()) {
+      const std::size_t x = open.back();
+      open.pop_back();
+      contacts.for_each(x, [&](std::size_t y) {
+        if (!in[y] && detail::alike(r.supervoxels[x].colour, r.supervoxels[y].colour,
                                     settings.tracking.max_chroma_distance)) {
-        body[y] = 1;
-        interacting[y] = 1;
-        open.push_back(y);
-      }
-    });
+          in[y] = 1;
+          open.push_back(y);
+        }
+      });
+    }
+  };
+  grow(body);
+  // The bodies that touch the object now and are not its holder.
+  std::vector<char> toucher(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (interacting[i] && !body[i] && candidate(i)) {
+      toucher[i] = 1;
+      open.push_back(i);
+    }
   }
+  grow(toucher);
+  if (!first && taken_by_hand(r, toucher)) {
+    for (std::size_t i = 0; i < n; ++i) body[i] = body[i] || toucher[i];
+  }
+  for (std::size_t i = 0; i < n; ++i) interacting[i] = interacting[i] || body[i];
   // Remembered as last seen, for as long as the object's hidden part is.
   std::vector<Eigen::Vector3f> seen;
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
@@ -164,6 +190,67 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
   } else if (++holder_age > settings.tracking.occlusion_memory_frames) {
     holder.clear();
   }
+}
+
+bool Perception::Impl::taken_by_hand(const PerceptionResult& r, const std::vector<char>& toucher) {
+  // A body that touches the object has taken it when, once the object has
+  // moved by kGripTravel since the body first touched it, the body's voxels
+  // lie where the object's motion has carried its voxels of then, not where
+  // they were: a hand that grips, not a wall or a standing hand that the
+  // object slides along, nor a hand that touches a still object. The
+  // motion is object_motion()'s (remember() carries grip.moved with it).
+  std::vector<Eigen::Vector3f> now;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (toucher[static_cast<std::size_t>(r.voxel_owner[i])]) now.push_back(r.voxels[i]);
+  }
+  if (now.empty()) {
+    grip.clear();
+    return false;
+  }
+  // Until the object moves, voxels of the bodies seen for the first time
+  // (a hand reaching in) join the reference as they are now.
+  const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
+  const auto mean = [](const std::vector<Eigen::Vector3f>& v) {
+    Eigen::Vector3f m = Eigen::Vector3f::Zero();
+    for (const Eigen::Vector3f& p : v) m += p;
+    return Eigen::Vector3f(m / static_cast<float>(std::max<std::size_t>(v.size(), 1)));
+  };
+  const auto travel = [&] { return (mean(grip.moved) - mean(grip.still)).norm(); };
+  if (travel() < 0.5f * res) {
+    detail::PointGrid reference;
+    reference.build(grip.moved, res);
+    for (const Eigen::Vector3f& p : now) {
+      if (!reference.any_within(p, res, [](int) { return true; })) {
+        grip.still.push_back(p);
+        grip.moved.push_back(p);
+      }
+    }
+  }
+  if (travel() < kGripTravel) return false;
+  // Each voxel of then against the body now: its distance to it carried
+  // with the object and left where it was (capped at kGripTravel; a voxel
+  // far from the body either way, of a body since gone, tells nothing).
+  // The body moved with the object when carried voxels lie on it at less
+  // than half the distance of those left where they were.
+  detail::PointGrid body_now;
+  body_now.build(now, kGripTravel);
+  const auto distance = [&](const Eigen::Vector3f& p) {
+    float best = kGripTravel * kGripTravel;
+    body_now.for_each_near(p, [&](int j) { best = std::min(best, (now[static_cast<std::size_t>(j)] - p).squaredNorm()); });
+    return std::sqrt(best);
+  };
+  double with_object = 0.0;
+  double where_it_was = 0.0;
+  const Eigen::Vector3f shift = mean(grip.moved) - mean(grip.still);
+  for (std::size_t i = 0; i < grip.still.size(); ++i) {
+    const float carried = distance(grip.still[i] + shift);
+    const float left = distance(grip.still[i]);
+    if (std::min(carried, left) >= kGripTravel) continue;
+    with_object += carried;
+    where_it_was += left;
+  }
+  grip.clear();  // decided: a new reference from the next frame on
+  return where_it_was > 0.0 && with_object < 0.5 * where_it_was;
 }
 
 void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object) {

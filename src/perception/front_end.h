@@ -210,6 +210,14 @@ struct Perception::Impl {
   detail::PointGrid seen_grid;                 // the frame's object voxels (remember())
   std::vector<Eigen::Vector3f> holder;  // holder_body: the holder's voxels when last seen (grow_holder())
   int holder_age = 0;                   // frames since the holder was last seen
+  struct Grip {  // taken_by_hand(): the touching body's voxels when it first touched the object
+    std::vector<Eigen::Vector3f> still;  // where they were
+    std::vector<Eigen::Vector3f> moved;  // carried by the object's motion since
+    void clear() {
+      still.clear();
+      moved.clear();
+    }
+  } grip;
   detail::PointGrid holder_grid;
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
   bool incomplete = false;  // the first frame showed an occluder cutting the object (behind_occluders())
@@ -286,6 +294,9 @@ struct Perception::Impl {
   /// holder_body: marks interacting the holder's body beyond the box (PerceptionSettings::holder_body).
   void grow_holder(const PerceptionResult& r, const std::vector<char>& object, const Eigen::Vector3d& c,
                    std::vector<char>& interacting);
+  /// classify.cpp: whether the bodies `toucher` (touching the object, not
+  /// its holder) have moved with the object since they first touched it.
+  bool taken_by_hand(const PerceptionResult& r, const std::vector<char>& toucher);
   /// classify.cpp: occluder points beyond the image border, where the
   /// occluders the border cuts continue (PerceptionSettings::beyond_view),
   /// appended to r.problem.occluders.

@@ -420,6 +420,7 @@ void Perception::Impl::remember(const RgbdFrame& frame, PerceptionResult& r,
   const Eigen::Isometry3d motion = object_motion(frame, r, object);
   const Eigen::Isometry3f motion_f = motion.cast<float>();
   for (Eigen::Vector3f& p : holder) p = motion_f * p;  // the holder moves with what it holds
+  for (Eigen::Vector3f& p : grip.moved) p = motion_f * p;
   std::vector<Eigen::Vector3f> next;
   std::vector<Eigen::Vector3f> next_chroma;
   std::vector<int> next_age;

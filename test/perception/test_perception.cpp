@@ -571,6 +571,62 @@ TEST(Perception, ThePartBeyondTheFirstImageJoinsTheObjectAsItComesIn) {
   }
 }
 
+/// Of the voxels of an arm reaching from the right beyond the case's
+/// augmented box (x > 0.14), how many there are and how many are in
+/// supervoxels of class `cls`.
+std::pair<int, int> arm_voxels(const perception::PerceptionResult& r, perception::SupervoxelClass cls) {
+  int seen = 0;
+  int as = 0;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (r.voxels[i].x() < 0.14f || r.voxels[i].z() < 0.02f) continue;  // the arm, not the table
+    ++seen;
+    as += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == cls;
+  }
+  return {seen, as};
+}
+
+TEST(Perception, ABodyThatCarriesTheObjectIsItsHolderOneItSlidesAlongIsNot) {
+  // An arm reaches from the right, touches the case's side (frames 3-5),
+  // then lifts the case, 5 mm a frame. Once the case has moved 2 cm with
+  // it, the arm beyond the box is the holder (interacting), not an
+  // occluder. When the arm stays where it touched and the case rises along
+  // it, the arm stays an occluder beyond the box (the paper's rule).
+  const auto arm = [](double gap, double lift) {
+    return test::make_capsule({0.115 + gap, -0.005, 0.07 + lift}, {0.32 + gap, -0.005, 0.07 + lift}, 0.02, kSkin,
+                              kHand);
+  };
+  perception::Perception carried{perception::PerceptionSettings{}};
+  perception::Perception slides{perception::PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  for (int k = 0; k <= 14; ++k) {
+    const double lift = k > 5 ? 0.005 * (k - 5) : 0.0;
+    const double gap = k < 3 ? 0.06 : 0.0;
+    const Eigen::Vector3d centre = kCaseCentre + Eigen::Vector3d(0.0, 0.0, lift);
+    test::SyntheticScene with = test::table_and_case(centre);
+    test::SyntheticScene along = with;
+    with.shapes.push_back(arm(gap, lift));
+    along.shapes.push_back(arm(gap, 0.0));
+    Frame fc = render(with, wMc, 320);
+    Frame fs = render(along, wMc, 320);
+    test::add_depth_noise(fc.frame, 21u + static_cast<unsigned>(k));
+    test::add_depth_noise(fs.frame, 21u + static_cast<unsigned>(k));
+    const perception::PerceptionResult rc = carried.process(fc.frame);
+    const perception::PerceptionResult rs = slides.process(fs.frame);
+    ASSERT_NE(rc.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rc.message;
+    ASSERT_NE(rs.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rs.message;
+    const auto [arm_c, holder_c] = arm_voxels(rc, perception::SupervoxelClass::Interacting);
+    const auto [arm_s, occluder_s] = arm_voxels(rs, perception::SupervoxelClass::Occluder);
+    ASSERT_GE(arm_c, 30) << "frame " << k;
+    if (k >= 3 && k <= 5) {
+      EXPECT_LE(holder_c, arm_c / 10) << "frame " << k << ": a touch is not a grip";
+    }
+    if (k == 14) {
+      EXPECT_GE(holder_c, arm_c * 9 / 10) << holder_c << " of the carrying arm's " << arm_c << " voxels";
+      EXPECT_GE(occluder_s, arm_s * 9 / 10) << occluder_s << " of the static arm's " << arm_s << " voxels";
+    }
+  }
+}
+
 /// Largest distance of the problem's hidden vertices (its last
 /// counts.hidden_vertices columns) from the case, the box of `centre` [m].
 double hidden_vertices_off_case(const perception::PerceptionResult& r, const Eigen::Vector3d& centre) {
