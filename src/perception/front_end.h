@@ -1,7 +1,7 @@
 // Internal: the state Perception carries from frame to frame, and its stages,
 // one file each along the frame's path:
 //   pipeline.cpp          the per-frame sequence (cloud, supervoxels, adjacency, ...)
-//   supervoxels.cpp       PCL's supervoxels (supervoxels=pcl); vccs.cpp: ofv's own (supervoxels=ofv)
+//   supervoxels.cpp       PCL's supervoxels (supervoxels=pcl); vccs.cpp: ofv's own (supervoxels=ofv, the default)
 //   object_selection.cpp  the first frame: support plane, then the object by box, image or cluster
 //   object_memory.cpp     later frames: the object found near its remembered voxels, its
 //                         motion; the memory updated, hidden voxels kept (and moved) for a while

@@ -99,11 +99,12 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
       }
       continue;
     }
+    // (A supervoxel too small for a normal tells nothing of its facing.)
     const bool edge_on = s.normal_valid && s.normal.dot((eye - p).normalized()) < kGrazing;
     if (!l || edge_on) {
       voxel_state[i] = 2;
       ++unseen[owner];
-    } else if (std::abs(d - l->z) <= t.max_motion) {
+    } else if (s.normal_valid && std::abs(d - l->z) <= t.max_motion) {
       ++seen_before[owner];
     }
   }
@@ -115,10 +116,13 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   // (revealed a strip at a time) are remembered, so that it joins once
   // enough of it is. Ambiguous, and left out: one linked, through
   // neighbours of one chromaticity that are not the object's, to a surface
-  // of that colour the previous frame showed (most of its voxels) that is
-  // not the object's (none near the memory): a distractor whose side the
-  // object hid could be either's, and a hand of the object's colour that
-  // touches it is one. Neighbours: two voxels within R_adj (eq. 1's
+  // of that colour the previous frame showed that is not the object's
+  // (supervoxels most of whose voxels it showed, none near the memory: one
+  // covering a seed cell's face or more, or together a quarter of the
+  // component's voxels; a few smaller ones on a surface seen grazing, their
+  // normals too noisy to tell their facing, do not): a distractor whose
+  // side the object hid could be either's, and a hand of the object's
+  // colour that touches it is one. Neighbours: two voxels within R_adj (eq. 1's
   // distance, here between voxels, not centroids: a strip revealed along a
   // distractor's edge, seen grazing, is a broken line of voxels whose
   // centroids lie farther than R_adj from the part it continues).
@@ -128,6 +132,8 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   const auto candidate = [&](std::size_t j) { return !object[j] && !on_plane(r.supervoxels[j]); };
   contacts.build(r, settings.supervoxels.adjacency_alpha * settings.supervoxels.seed_resolution,
                  [&](std::size_t j) { return !on_plane(r.supervoxels[j]); });
+  const double per_side = settings.supervoxels.seed_resolution / settings.supervoxels.voxel_resolution;
+  const int cell_face = std::max(1, static_cast<int>(per_side * per_side));  // voxels on a seed cell's face
   const auto seen_not_object = [&](std::size_t j) {
     return 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0;
   };
@@ -140,14 +146,21 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   for (std::size_t j = 0; j < n; ++j) {
     if ((revealed[j] == 0 && unseen[j] == 0) || component[j] >= 0 || !candidate(j)) continue;
     const int id = static_cast<int>(component_ambiguous.size());
-    bool ambiguous = false;
+    int voxels = 0;
+    int seen_voxels = 0;
+    bool seen_surface = false;
     bool touches = false;
     component[j] = id;
     open.assign(1, j);
     while (!open.empty()) {
       const std::size_t x = open.back();
       open.pop_back();
-      ambiguous = ambiguous || seen_not_object(x);
+      const int count = r.supervoxels[x].voxel_count;
+      voxels += count;
+      if (seen_not_object(x)) {
+        seen_voxels += count;
+        seen_surface = seen_surface || count >= cell_face;
+      }
       contacts.for_each(x, [&](std::size_t y) {
         if (!alike(x, y)) return;
         if (object[y]) {
@@ -158,6 +171,7 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
         }
       });
     }
+    const bool ambiguous = seen_surface || 4 * seen_voxels >= voxels;
     component_ambiguous.push_back(ambiguous ? 1 : 0);
     component_touches.push_back(touches ? 1 : 0);
   }

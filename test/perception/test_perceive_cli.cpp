@@ -109,10 +109,11 @@ TEST(PerceiveCli, ARecordingWithLabelsIsScored) {
   EXPECT_TRUE(j["scores"]["centroid_error_m"].is_null());  // the recording has no object centroid
   EXPECT_TRUE(j["scores"]["occluder_recall"].is_null());
 
-  // The front end's own settings go through --set too: ofv's supervoxel
-  // stage scores as well on the same frames; a word it does not know is exit 2.
-  const fs::path out_ofv = fs::path(test::scratch_dir()) / "ofv_perceive_labelled_ofv";
-  const CommandRun mine = run("perceive " + dir.string() + " --set supervoxels=ofv --out " + out_ofv.string());
+  // The front end's own settings go through --set too: PCL's supervoxel
+  // stage (the reference) scores as well on the same frames; a word it does
+  // not know is exit 2.
+  const fs::path out_ofv = fs::path(test::scratch_dir()) / "ofv_perceive_labelled_pcl";
+  const CommandRun mine = run("perceive " + dir.string() + " --set supervoxels=pcl --out " + out_ofv.string());
   ASSERT_EQ(mine.code, 0) << mine.err;
   std::ifstream in_ofv(out_ofv / "frame_000002.json");
   const auto k = nlohmann::json::parse(in_ofv);

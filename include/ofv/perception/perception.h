@@ -50,10 +50,10 @@ namespace ofv::perception {
 struct SupervoxelSettings {
   /// \brief Which implementation of VCCS supervoxels cuts the cloud.
   enum class Method {
-    Ofv,  ///< ofv's own, on the voxel grid (src/perception/vccs.h): 2-3x faster
-    Pcl,  ///< pcl::SupervoxelClustering: the default, the reference (docs/perception.md)
+    Ofv,  ///< ofv's own, on the voxel grid (src/perception/vccs.h): the default, 2-3x faster
+    Pcl,  ///< pcl::SupervoxelClustering: the reference (docs/perception.md compares them)
   };
-  Method method = Method::Pcl;  ///< the implementation
+  Method method = Method::Ofv;  ///< the implementation
   double voxel_resolution = 0.008;  ///< voxel edge [m]
   double seed_resolution = EstimatorSettings{}.r_seed;  ///< R_seed: spacing of supervoxel seeds [m] (paper: 0.02)
   double colour_importance = 0.2;   ///< weight of colour distance in the clustering
