@@ -236,14 +236,14 @@ bool Perception::Impl::taken_by_hand(const PerceptionResult& r, const std::vecto
   body_now.build(now, kGripTravel);
   const auto distance = [&](const Eigen::Vector3f& p) {
     float best = kGripTravel * kGripTravel;
-    body_now.for_each_near(p, [&](int j) { best = std::min(best, (now[static_cast<std::size_t>(j)] - p).squaredNorm()); });
+    body_now.for_each_near(p,
+                           [&](int j) { best = std::min(best, (now[static_cast<std::size_t>(j)] - p).squaredNorm()); });
     return std::sqrt(best);
   };
   double with_object = 0.0;
   double where_it_was = 0.0;
-  const Eigen::Vector3f shift = mean(grip.moved) - mean(grip.still);
   for (std::size_t i = 0; i < grip.still.size(); ++i) {
-    const float carried = distance(grip.still[i] + shift);
+    const float carried = distance(grip.moved[i]);
     const float left = distance(grip.still[i]);
     if (std::min(carried, left) >= kGripTravel) continue;
     with_object += carried;
