@@ -142,7 +142,6 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
               : (interacting[owner] || r.obb.contains(s.centroid)) &&
                     holder_grid.any_within(r.voxels[i], radius, [](int) { return true; })) {
       body[owner] = 1;
-      interacting[owner] = 1;
       open.push_back(owner);
     }
   }
@@ -150,9 +149,14 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
     const SupervoxelInfo& s = r.supervoxels[j];
     return !object[j] && !on_plane(s) && (s.centroid - c).norm() < settings.r_sphere;
   };
-  contacts.build(r, settings.contact_distance, candidate);
-  // Grows `in` from the supervoxels in `open` through those in contact and of their colour.
+  // Grows `in` from the supervoxels in `open` through those in contact and
+  // of their colour (the contacts hashed once a frame, when anything grows).
+  bool hashed = false;
   const auto grow = [&](std::vector<char>& in) {
+    if (!open.empty() && !hashed) {
+      contacts.build(r, settings.contact_distance, candidate);
+      hashed = true;
+    }
     while (!open.empty()) {
       const std::size_t x = open.back();
       open.pop_back();
