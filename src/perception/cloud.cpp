@@ -3,6 +3,8 @@
 
 #include "ofv/estimator.h"
 
+#include "point_grid.h"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -45,12 +47,17 @@ void check_frame(const RgbdFrame& frame) {
   }
 }
 
-CloudBuilder::CloudBuilder(const CloudSettings& settings) : settings_(settings) {
+CloudBuilder::CloudBuilder(const CloudSettings& settings)
+    : settings_(settings), cell_of_key_(std::make_unique<detail::CellMap>()) {
   if (settings_.pixel_stride < 1) {
     throw std::invalid_argument("pixel_stride " + std::to_string(settings_.pixel_stride) +
                                 ": expected an integer >= 1");
   }
 }
+
+CloudBuilder::~CloudBuilder() = default;
+CloudBuilder::CloudBuilder(CloudBuilder&&) noexcept = default;
+CloudBuilder& CloudBuilder::operator=(CloudBuilder&&) noexcept = default;
 
 void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCloud& out) {
   check_frame(frame);
@@ -76,8 +83,11 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
   const double res = settings_.voxel_resolution;
   const bool voxelise = res > 0.0;
   const float inv_res = voxelise ? static_cast<float>(1.0 / res) : 0.0f;
-  cell_of_key_.clear();
+  cell_of_key_->reset(cells_.size());  // the last frame's voxel count
   cells_.clear();
+  // Neighbouring pixels mostly fall in one voxel: the last one is looked up first.
+  std::uint64_t last_key = ~std::uint64_t{0};
+  int last = -1;
 
   const int stride = settings_.pixel_stride;
   for (int v = 0; v < k.height; v += stride) {
@@ -110,22 +120,20 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
         out.colours.push_back(colour);
         continue;
       }
-      // 21 bits per axis: +-8 km at 8 mm voxels, far beyond any crop.
-      const auto cell = [inv_res](float x) {
-        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x * inv_res)) +
-                                          (std::int64_t{1} << 20)) &
-               0x1FFFFFu;
-      };
-      const std::uint64_t key = cell(pw.x()) | (cell(pw.y()) << 21) | (cell(pw.z()) << 42);
-      const auto [it, inserted] = cell_of_key_.try_emplace(key, static_cast<int>(cells_.size()));
-      if (inserted) {
-        cells_.push_back({pw, colour, 1});
-      } else {
-        Accumulator& a = cells_[static_cast<std::size_t>(it->second)];
-        a.sum_point += pw;
-        a.sum_colour += colour;
-        ++a.count;
+      const std::uint64_t key = detail::cell_key((pw * inv_res).array().floor().cast<int>());
+      if (key != last_key) {
+        int& slot = cell_of_key_->find_or_insert(key);
+        if (slot < 0) {
+          slot = static_cast<int>(cells_.size());
+          cells_.push_back({Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero(), 0});
+        }
+        last_key = key;
+        last = slot;
       }
+      Accumulator& a = cells_[static_cast<std::size_t>(last)];
+      a.sum_point += pw;
+      a.sum_colour += colour;
+      ++a.count;
     }
   }
   if (voxelise) {

@@ -165,6 +165,7 @@ struct Perception::Impl {
   CloudBuilder builder;
   WorldCloud cloud;
   detail::SupervoxelOutput sv;
+  detail::Vccs vccs;
   detail::PointGrid grid;  // for adjacency and tracking
   std::vector<Eigen::Vector3f> centroids;
   std::vector<Eigen::Vector3d> object_cloud;  // classify(): visible + hidden object voxels

@@ -51,7 +51,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   if (settings.supervoxels.method == SupervoxelSettings::Method::Pcl) {
     detail::cluster_supervoxels(cloud, settings.supervoxels, frame.wMc.translation(), sv);
   } else {
-    detail::vccs_supervoxels(cloud, settings.supervoxels, frame.wMc.translation(), sv);
+    vccs.run(cloud, settings.supervoxels, frame.wMc.translation(), sv);
   }
   const bool labelled = settings.classes == PerceptionSettings::Classes::Labels;
   if (labelled) split_by_labels(frame);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace ofv::perception::detail {
@@ -18,24 +19,31 @@ inline std::uint64_t cell_key(const Eigen::Vector3i& c) {
   return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
 }
 
-/// Cells (keys of cell_key()) to indices: open addressing, linear probing.
+/// Cells (keys of cell_key()) to indices: open addressing, linear probing;
+/// doubles when half full.
 class CellMap {
  public:
-  /// Empties the map, sized for `count` keys at most.
+  /// Empties the map, sized for `count` keys (it grows past them).
   void reset(std::size_t count) {
     std::size_t size = 16;
     while (size < 2 * count) size *= 2;
     mask_ = size - 1;
     keys_.assign(size, kEmpty);
     values_.resize(size);
+    size_ = 0;
   }
+  /// The number of keys stored.
+  [[nodiscard]] std::size_t size() const { return size_; }
   /// The index stored for `key`, to be set by the caller when it is new (-1).
+  /// The reference holds until the next insertion.
   int& find_or_insert(std::uint64_t key) {
+    if (2 * (size_ + 1) > keys_.size()) grow();
     std::size_t i = slot(key);
     while (keys_[i] != key && keys_[i] != kEmpty) i = (i + 1) & mask_;
     if (keys_[i] == kEmpty) {
       keys_[i] = key;
       values_[i] = -1;
+      ++size_;
     }
     return values_[i];
   }
@@ -53,7 +61,16 @@ class CellMap {
   [[nodiscard]] std::size_t slot(std::uint64_t key) const {
     return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
   }
+  void grow() {
+    std::vector<std::uint64_t> keys = std::move(keys_);
+    std::vector<int> values = std::move(values_);
+    reset(std::max<std::size_t>(keys.size(), 8));  // twice the slots
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (keys[i] != kEmpty) find_or_insert(keys[i]) = values[i];
+    }
+  }
   std::size_t mask_ = 0;
+  std::size_t size_ = 0;
   std::vector<std::uint64_t> keys_;
   std::vector<int> values_;
 };

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <vector>
@@ -70,13 +71,19 @@ struct Voxels {
   std::vector<int> neighbours;
   CellMap map;  // every occupied cell -> its voxel (two cells for a merged one)
   std::vector<std::pair<Eigen::Vector3i, int>> owners;  // every occupied cell and its voxel
+  // Scratch, kept from frame to frame for its capacity.
+  using Moments = Eigen::Matrix<double, 10, 1>;
+  std::vector<int> points, fill, survivor, index;
+  std::vector<char> paired;
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<Moments> own, ring;
 
   void build(const WorldCloud& cloud, float inv_voxel) {
     // Voxels in the order of their first point; points sharing a cell averaged.
     map.reset(cloud.points.size());
     features.clear();
     cells.clear();
-    std::vector<int> count;
+    points.clear();  // per voxel
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
       const Eigen::Vector3i c = cell_of(cloud.points[i], inv_voxel);
       int& slot = map.find_or_insert(cell_key(c));
@@ -84,18 +91,18 @@ struct Voxels {
         slot = static_cast<int>(features.size());
         features.push_back({cloud.points[i], cloud.colours[i], Eigen::Vector3f::Zero()});
         cells.push_back(c);
-        count.push_back(1);
+        points.push_back(1);
         continue;
       }
       Feature& f = features[static_cast<std::size_t>(slot)];
       f.position += cloud.points[i];
       f.colour += cloud.colours[i];
-      ++count[static_cast<std::size_t>(slot)];
+      ++points[static_cast<std::size_t>(slot)];
     }
     for (std::size_t i = 0; i < features.size(); ++i) {
-      if (count[i] == 1) continue;
-      features[i].position /= static_cast<float>(count[i]);
-      features[i].colour /= static_cast<float>(count[i]);
+      if (points[i] == 1) continue;
+      features[i].position /= static_cast<float>(points[i]);
+      features[i].colour /= static_cast<float>(points[i]);
     }
     merge_split_patches(1.0f / inv_voxel);
     const std::size_t n = features.size();
@@ -113,27 +120,44 @@ struct Voxels {
       }
       return out;
     }();
-    std::vector<std::pair<int, int>> pairs;
+    // Each pair is found once per pair of their cells: counted, filled at
+    // both ends, then each list sorted (ascending, the order growth offers
+    // them in) and its repeats (a joined voxel's two cells) dropped.
+    pairs.clear();
+    first.assign(n + 1, 0);
     for (const auto& [c, i] : owners) {
       for (const Eigen::Vector3i& d : kForward) {
         const int j = map.find(cell_key(c + d));
-        if (j >= 0 && j != i) pairs.emplace_back(std::min(i, j), std::max(i, j));
+        if (j < 0 || j == i) continue;
+        pairs.emplace_back(i, j);
+        ++first[static_cast<std::size_t>(i) + 1];
+        ++first[static_cast<std::size_t>(j) + 1];
       }
-    }
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    first.assign(n + 1, 0);
-    for (const auto& [i, j] : pairs) {
-      ++first[static_cast<std::size_t>(i) + 1];
-      ++first[static_cast<std::size_t>(j) + 1];
     }
     for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
     neighbours.resize(2 * pairs.size());
-    std::vector<int> fill(first.begin(), first.end() - 1);
+    fill.assign(first.begin(), first.end() - 1);
     for (const auto& [i, j] : pairs) {
       neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(i)]++)] = j;
       neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = i;
     }
+    int kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto begin = neighbours.begin() + first[i];
+      const auto end = neighbours.begin() + first[i + 1];
+      for (auto a = begin + 1; a < end; ++a) {  // insertion sort: a few tens at most
+        const int x = *a;
+        auto b = a;
+        for (; b != begin && *(b - 1) > x; --b) *b = *(b - 1);
+        *b = x;
+      }
+      first[i] = kept;
+      for (auto a = begin; a != end; ++a) {
+        if (a == begin || *a != *(a - 1)) neighbours[static_cast<std::size_t>(kept++)] = *a;
+      }
+    }
+    first[n] = kept;
+    neighbours.resize(static_cast<std::size_t>(kept));
   }
 
   /// A surface lying along a cell face (a cloth facing the camera at a
@@ -152,9 +176,9 @@ struct Voxels {
     // Two surfaces that touch (a finger on a case) differ in colour more than one surface's noise.
     constexpr float kSameColour = 25.0f;  // RGB distance, of 441 at most
     const std::size_t n = features.size();
-    std::vector<int> survivor(n);  // the voxel each one becomes
+    survivor.resize(n);  // the voxel each one becomes
     std::iota(survivor.begin(), survivor.end(), 0);
-    std::vector<char> paired(n, 0);
+    paired.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
       for (int axis = 0; axis < 3 && !paired[i]; ++axis) {
         const int j = map.find(cell_key(cells[i] + Eigen::Vector3i::Unit(axis)));
@@ -172,7 +196,7 @@ struct Voxels {
       }
     }
     // Survivors keep their order; every cell leads to its voxel's new index.
-    std::vector<int> index(n, -1);
+    index.assign(n, -1);
     int kept = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (survivor[i] == static_cast<int>(i)) index[i] = kept++;
@@ -220,11 +244,11 @@ struct Voxels {
   /// neighbours (a voxel once per path to it). Moments [1, x, y, z, xx, xy,
   /// xz, yy, yz, zz] summed over one ring, then over the ring of those sums.
   void compute_normals(const Eigen::Vector3f& camera) {
-    using Moments = Eigen::Matrix<double, 10, 1>;
     const std::size_t n = features.size();
     if (n == 0) return;
     const Eigen::Vector3f origin = features[0].position;  // small numbers: no cancellation
-    std::vector<Moments> own(n), ring(n);
+    own.resize(n);
+    ring.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d p = (features[i].position - origin).cast<double>();
       own[i] << 1.0, p.x(), p.y(), p.z(), p.x() * p.x(), p.x() * p.y(), p.x() * p.z(), p.y() * p.y(),
@@ -262,26 +286,43 @@ struct Growing {
 
 }  // namespace
 
-void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& settings, const Eigen::Vector3d& camera,
-                      SupervoxelOutput& out) {
+struct Vccs::Scratch {
+  Voxels v;
+  CellMap seed_cells;
+  std::vector<int> candidates;  // per seed cell, its voxel so far
+  std::vector<float> candidate_distance;
+  std::vector<Growing> growing;
+  std::vector<int> owner;
+  std::vector<float> best;
+  std::vector<int> taken, listed, renumber, seen, touching;
+};
+
+Vccs::Vccs() : scratch_(std::make_unique<Scratch>()) {}
+Vccs::~Vccs() = default;
+Vccs::Vccs(Vccs&&) noexcept = default;
+Vccs& Vccs::operator=(Vccs&&) noexcept = default;
+
+void Vccs::run(const WorldCloud& cloud, const SupervoxelSettings& settings, const Eigen::Vector3d& camera,
+               SupervoxelOutput& out) {
   out.clear();
   if (cloud.points.empty()) return;
   const auto voxel = static_cast<float>(settings.voxel_resolution);
   const auto seed = static_cast<float>(settings.seed_resolution);
   const Eigen::Vector3f eye = camera.cast<float>();
 
+  auto& [v, seed_cells, candidates, candidate_distance, growing, owner, best, taken, listed, renumber, seen,
+         touching] = *scratch_;
+
   // 1-2. Voxels, neighbours, normals.
-  Voxels v;
   v.build(cloud, 1.0f / voxel);
   v.compute_normals(eye);
   const std::size_t n = v.features.size();
 
   // 3. Seeds: per cell of edge R_seed, the voxel nearest its centre (the
   // first such voxel on a tie), cells in the order of their first voxel.
-  CellMap seed_cells;
   seed_cells.reset(n);
-  std::vector<int> candidates;  // per seed cell, its voxel so far
-  std::vector<float> candidate_distance;
+  candidates.clear();
+  candidate_distance.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3i c = cell_of(v.features[i].position, 1.0f / seed);
     const Eigen::Vector3f centre = (c.cast<float>() + Eigen::Vector3f::Constant(0.5f)) * seed;
@@ -298,9 +339,9 @@ void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& setting
   }
   const float search = 0.5f * seed;
   const double min_count = 0.05 * M_PI * static_cast<double>(search) * search / (static_cast<double>(voxel) * voxel);
-  std::vector<Growing> growing;
-  std::vector<int> owner(n, -1);
-  std::vector<float> best(n, std::numeric_limits<float>::infinity());
+  growing.clear();
+  owner.assign(n, -1);
+  best.assign(n, std::numeric_limits<float>::infinity());
   for (const int s : candidates) {
     if (!v.more_within(s, search, voxel, min_count)) continue;
     const Feature& f = v.features[static_cast<std::size_t>(s)];
@@ -313,8 +354,7 @@ void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& setting
   const Weights w{static_cast<float>(settings.normal_importance), static_cast<float>(settings.colour_importance),
                   static_cast<float>(settings.spatial_importance), 1.0f / seed};
   const int depth = static_cast<int>(1.8f * seed / voxel);
-  std::vector<int> taken;
-  std::vector<int> listed(n, 0);  // the last round whose compaction kept the voxel
+  listed.assign(n, 0);  // the last round whose compaction kept the voxel
   for (int round = 1; round < depth; ++round) {
     for (std::size_t s = 0; s < growing.size(); ++s) {
       Growing& g = growing[s];
@@ -338,7 +378,7 @@ void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& setting
     // New centres; supervoxels left empty are dropped (their indices move).
     // A supervoxel's list keeps each voxel it owns once (one it lost and took
     // back this round is listed twice).
-    std::vector<int> renumber(growing.size(), -1);
+    renumber.assign(growing.size(), -1);
     std::size_t kept = 0;
     for (std::size_t s = 0; s < growing.size(); ++s) {
       Growing& g = growing[s];
@@ -402,8 +442,7 @@ void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& setting
       out.owner.push_back(static_cast<int>(s));
     }
   }
-  std::vector<int> seen(growing.size(), -1);  // the last supervoxel that listed this one
-  std::vector<int> touching;
+  seen.assign(growing.size(), -1);  // the last supervoxel that listed this one
   for (std::size_t a = 0; a < growing.size(); ++a) {
     touching.clear();
     for (const int i : growing[a].voxels) {
@@ -418,6 +457,11 @@ void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& setting
     std::sort(touching.begin(), touching.end());
     for (const int b : touching) out.touching.emplace_back(static_cast<int>(a), b);
   }
+}
+
+void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& settings, const Eigen::Vector3d& camera,
+                      SupervoxelOutput& out) {
+  Vccs().run(cloud, settings, camera, out);
 }
 
 }  // namespace ofv::perception::detail

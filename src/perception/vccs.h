@@ -44,11 +44,30 @@
 
 #include "pcl_stages.h"
 
+#include <memory>
+
 namespace ofv::perception::detail {
 
 /// The supervoxels of `cloud` (world frame) by the algorithm above; normals
 /// face `camera` (world frame). Deterministic: the same cloud gives the same
-/// output.
+/// output, whatever came before.
+class Vccs {
+ public:
+  Vccs();
+  ~Vccs();
+  Vccs(Vccs&&) noexcept;
+  Vccs& operator=(Vccs&&) noexcept;
+
+  /// Fills `out`; the buffers of the run are kept for the next (their capacity only).
+  void run(const WorldCloud& cloud, const SupervoxelSettings& settings, const Eigen::Vector3d& camera,
+           SupervoxelOutput& out);
+
+ private:
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;
+};
+
+/// One run of a fresh Vccs.
 void vccs_supervoxels(const WorldCloud& cloud, const SupervoxelSettings& settings, const Eigen::Vector3d& camera,
                       SupervoxelOutput& out);
 

@@ -13,11 +13,14 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include <cstdint>
-#include <unordered_map>
+#include <memory>
 #include <vector>
 
 namespace ofv::perception {
+
+namespace detail {
+class CellMap;
+}
 
 /// \brief The working volume: points outside it are dropped before anything else.
 struct CropVolume {
@@ -68,6 +71,9 @@ class CloudBuilder {
  public:
   /// \throws std::invalid_argument if `pixel_stride` < 1.
   explicit CloudBuilder(const CloudSettings& settings = {});
+  ~CloudBuilder();
+  CloudBuilder(CloudBuilder&&) noexcept;
+  CloudBuilder& operator=(CloudBuilder&&) noexcept;
 
   /// \brief Fills `out` from `frame` cropped to `crop`.
   /// \throws std::invalid_argument if the frame's image sizes disagree with its intrinsics.
@@ -83,7 +89,7 @@ class CloudBuilder {
     int count;
   };
   CloudSettings settings_;
-  std::unordered_map<std::uint64_t, int> cell_of_key_;  // voxel key -> index in cells_
+  std::unique_ptr<detail::CellMap> cell_of_key_;  // voxel key -> index in cells_
   std::vector<Accumulator> cells_;
 };
 
