@@ -11,7 +11,7 @@ if(io IN_LIST _ofv_components OR loop IN_LIST _ofv_components)
   list(APPEND _ofv_deb_depends nlohmann-json3-dev)
 endif()
 if(perception IN_LIST _ofv_components)
-  list(APPEND _ofv_deb_depends libpcl-dev libopencv-dev libopenni2-dev)
+  list(APPEND _ofv_deb_depends libpcl-dev libopencv-dev libopenni2-dev libtbb-dev)
 endif()
 if(sim IN_LIST _ofv_components)
   # `ofv render` writes PNG and video with OpenCV.

@@ -5,6 +5,9 @@
 
 #include "point_grid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -47,8 +50,24 @@ void check_frame(const RgbdFrame& frame) {
   }
 }
 
+struct CloudBuilder::Scratch {
+  struct Accumulator {
+    Eigen::Vector3f sum_point;
+    Eigen::Vector3f sum_colour;
+    int count;
+  };
+  static constexpr std::uint64_t kDropped = ~std::uint64_t{0};  // never a cell key (63 bits)
+  detail::CellMap cell_of_key;    // voxel key -> index in cells
+  std::vector<Accumulator> cells;
+  // Per sampled pixel (row by row): its world point and its voxel's key
+  // (any other value than kDropped when not voxelising), or kDropped.
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::uint64_t> keys;
+  std::vector<std::size_t> valid, cropped;  // per sampled row
+};
+
 CloudBuilder::CloudBuilder(const CloudSettings& settings)
-    : settings_(settings), cell_of_key_(std::make_unique<detail::CellMap>()) {
+    : settings_(settings), scratch_(std::make_unique<Scratch>()) {
   if (settings_.pixel_stride < 1) {
     throw std::invalid_argument("pixel_stride " + std::to_string(settings_.pixel_stride) +
                                 ": expected an integer >= 1");
@@ -79,39 +98,63 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
   const float cx = static_cast<float>(k.cx);
   const float cy = static_cast<float>(k.cy);
   const bool has_rgb = !frame.rgb.empty();
-
   const double res = settings_.voxel_resolution;
   const bool voxelise = res > 0.0;
   const float inv_res = voxelise ? static_cast<float>(1.0 / res) : 0.0f;
-  cell_of_key_->reset(cells_.size());  // the last frame's voxel count
-  cells_.clear();
-  // Neighbouring pixels mostly fall in one voxel: the last one is looked up first.
-  std::uint64_t last_key = ~std::uint64_t{0};
-  int last = -1;
-
   const int stride = settings_.pixel_stride;
-  for (int v = 0; v < k.height; v += stride) {
-    const float yn = (static_cast<float>(v) - cy) * inv_fy;
-    for (int u = 0; u < k.width; u += stride) {
-      const std::size_t i = frame.index(u, v);
-      const float z = frame.depth[i];
-      if (!(z > 0.0f) || !std::isfinite(z)) {
-        continue;
+  const auto rows = static_cast<std::size_t>((k.height + stride - 1) / stride);
+  const auto cols = static_cast<std::size_t>((k.width + stride - 1) / stride);
+  Scratch& s = *scratch_;
+  s.points.resize(rows * cols);
+  s.keys.resize(rows * cols);
+  s.valid.resize(rows);
+  s.cropped.resize(rows);
+
+  // 1. Every sampled pixel's world point and voxel, rows in parallel.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, 8), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t r = range.begin(); r < range.end(); ++r) {
+      const int v = static_cast<int>(r) * stride;
+      const float yn = (static_cast<float>(v) - cy) * inv_fy;
+      std::size_t valid = 0, cropped = 0;
+      for (std::size_t c = 0; c < cols; ++c) {
+        const int u = static_cast<int>(c) * stride;
+        std::uint64_t& key = s.keys[r * cols + c];
+        key = Scratch::kDropped;
+        const float z = frame.depth[frame.index(u, v)];
+        if (!(z > 0.0f) || !std::isfinite(z)) continue;
+        ++valid;
+        if (z > max_depth) continue;
+        const Eigen::Vector3f pc((static_cast<float>(u) - cx) * inv_fx * z, yn * z, z);
+        const Eigen::Vector3f pw = wRc * pc + wtc;
+        if (use_box && ((pw.array() < box_min.array()).any() || (pw.array() > box_max.array()).any())) continue;
+        if (use_sphere && (pw - centre).squaredNorm() > radius2) continue;
+        ++cropped;
+        s.points[r * cols + c] = pw;
+        key = voxelise ? detail::cell_key((pw * inv_res).array().floor().cast<int>()) : 0;
       }
-      ++out.valid_pixels;
-      if (z > max_depth) {
-        continue;
-      }
-      const Eigen::Vector3f pc((static_cast<float>(u) - cx) * inv_fx * z, yn * z, z);
-      const Eigen::Vector3f pw = wRc * pc + wtc;
-      if (use_box &&
-          ((pw.array() < box_min.array()).any() || (pw.array() > box_max.array()).any())) {
-        continue;
-      }
-      if (use_sphere && (pw - centre).squaredNorm() > radius2) {
-        continue;
-      }
-      ++out.cropped_points;
+      s.valid[r] = valid;
+      s.cropped[r] = cropped;
+    }
+  });
+  for (std::size_t r = 0; r < rows; ++r) {
+    out.valid_pixels += s.valid[r];
+    out.cropped_points += s.cropped[r];
+  }
+
+  // 2. Points, or voxel means, in pixel order: the voxels in the order of
+  // their first pixel, each sum in pixel order (the same cloud whatever the
+  // threads).
+  s.cell_of_key.reset(s.cells.size());  // the last frame's voxel count
+  s.cells.clear();
+  // Neighbouring pixels mostly fall in one voxel: the last one is looked up first.
+  std::uint64_t last_key = Scratch::kDropped;
+  int last = -1;
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t c = 0; c < cols; ++c) {
+      const std::uint64_t key = s.keys[r * cols + c];
+      if (key == Scratch::kDropped) continue;
+      const Eigen::Vector3f& pw = s.points[r * cols + c];
+      const std::size_t i = frame.index(static_cast<int>(c) * stride, static_cast<int>(r) * stride);
       const Eigen::Vector3f colour =
           has_rgb ? Eigen::Vector3f(frame.rgb[3 * i], frame.rgb[3 * i + 1], frame.rgb[3 * i + 2])
                   : Eigen::Vector3f(128.0f, 128.0f, 128.0f);
@@ -120,26 +163,25 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
         out.colours.push_back(colour);
         continue;
       }
-      const std::uint64_t key = detail::cell_key((pw * inv_res).array().floor().cast<int>());
       if (key != last_key) {
-        int& slot = cell_of_key_->find_or_insert(key);
+        int& slot = s.cell_of_key.find_or_insert(key);
         if (slot < 0) {
-          slot = static_cast<int>(cells_.size());
-          cells_.push_back({Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero(), 0});
+          slot = static_cast<int>(s.cells.size());
+          s.cells.push_back({Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero(), 0});
         }
         last_key = key;
         last = slot;
       }
-      Accumulator& a = cells_[static_cast<std::size_t>(last)];
+      Scratch::Accumulator& a = s.cells[static_cast<std::size_t>(last)];
       a.sum_point += pw;
       a.sum_colour += colour;
       ++a.count;
     }
   }
   if (voxelise) {
-    out.points.reserve(cells_.size());
-    out.colours.reserve(cells_.size());
-    for (const Accumulator& a : cells_) {
+    out.points.reserve(s.cells.size());
+    out.colours.reserve(s.cells.size());
+    for (const Scratch::Accumulator& a : s.cells) {
       const float inv = 1.0f / static_cast<float>(a.count);
       out.points.push_back(a.sum_point * inv);
       out.colours.push_back(a.sum_colour * inv);

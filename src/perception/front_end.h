@@ -167,6 +167,7 @@ struct Perception::Impl {
   detail::SupervoxelOutput sv;
   detail::Vccs vccs;
   detail::PointGrid grid;  // for adjacency and tracking
+  std::vector<std::vector<std::pair<int, int>>> adjacency_found;  // adjacency(): per range of supervoxels
   std::vector<Eigen::Vector3f> centroids;
   std::vector<Eigen::Vector3d> object_cloud;  // classify(): visible + hidden object voxels
   std::vector<Eigen::Vector3f> object_points;  // the same, hashed in object_grid (interacting elements)

@@ -19,17 +19,18 @@ inline std::uint64_t cell_key(const Eigen::Vector3i& c) {
   return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
 }
 
-/// Cells (keys of cell_key()) to indices: open addressing, linear probing;
-/// doubles when half full.
+/// Cells (keys of cell_key()) to indices: open addressing, linear probing
+/// (a key and its index share a cache line); doubles when half full.
 class CellMap {
  public:
   /// Empties the map, sized for `count` keys (it grows past them).
   void reset(std::size_t count) {
     std::size_t size = 16;
-    while (size < 2 * count) size *= 2;
+    int bits = 4;
+    for (; size < 2 * count; ++bits) size *= 2;
     mask_ = size - 1;
-    keys_.assign(size, kEmpty);
-    values_.resize(size);
+    shift_ = 64 - bits;
+    slots_.assign(size, Slot{});
     size_ = 0;
   }
   /// The number of keys stored.
@@ -37,42 +38,45 @@ class CellMap {
   /// The index stored for `key`, to be set by the caller when it is new (-1).
   /// The reference holds until the next insertion.
   int& find_or_insert(std::uint64_t key) {
-    if (2 * (size_ + 1) > keys_.size()) grow();
+    if (2 * (size_ + 1) > slots_.size()) grow();
     std::size_t i = slot(key);
-    while (keys_[i] != key && keys_[i] != kEmpty) i = (i + 1) & mask_;
-    if (keys_[i] == kEmpty) {
-      keys_[i] = key;
-      values_[i] = -1;
+    while (slots_[i].key != key && slots_[i].key != kEmpty) i = (i + 1) & mask_;
+    if (slots_[i].key == kEmpty) {
+      slots_[i].key = key;
       ++size_;
     }
-    return values_[i];
+    return slots_[i].value;
   }
   /// The index stored for `key`, or -1.
   [[nodiscard]] int find(std::uint64_t key) const {
-    if (keys_.empty()) return -1;
+    if (slots_.empty()) return -1;
     for (std::size_t i = slot(key);; i = (i + 1) & mask_) {
-      if (keys_[i] == key) return values_[i];
-      if (keys_[i] == kEmpty) return -1;
+      if (slots_[i].key == key) return slots_[i].value;
+      if (slots_[i].key == kEmpty) return -1;
     }
   }
 
  private:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // never a cell_key (63 bits)
+  struct Slot {
+    std::uint64_t key = kEmpty;
+    int value = -1;
+  };
+  // Fibonacci hashing: the product's top bits depend on all of the key's (z too).
   [[nodiscard]] std::size_t slot(std::uint64_t key) const {
-    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
+    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_);
   }
   void grow() {
-    std::vector<std::uint64_t> keys = std::move(keys_);
-    std::vector<int> values = std::move(values_);
-    reset(std::max<std::size_t>(keys.size(), 8));  // twice the slots
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      if (keys[i] != kEmpty) find_or_insert(keys[i]) = values[i];
+    const std::vector<Slot> old = std::move(slots_);
+    reset(std::max<std::size_t>(old.size(), 8));  // twice the slots
+    for (const Slot& s : old) {
+      if (s.key != kEmpty) find_or_insert(s.key) = s.value;
     }
   }
   std::size_t mask_ = 0;
+  int shift_ = 64;
   std::size_t size_ = 0;
-  std::vector<std::uint64_t> keys_;
-  std::vector<int> values_;
+  std::vector<Slot> slots_;
 };
 
 /// Points hashed on a uniform grid: "is any point within r of p" in O(1).

@@ -4,6 +4,9 @@
 
 #include "point_grid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -75,7 +78,7 @@ struct Voxels {
   using Moments = Eigen::Matrix<double, 10, 1>;
   std::vector<int> points, fill, survivor, index;
   std::vector<char> paired;
-  std::vector<std::pair<int, int>> pairs;
+  std::vector<std::vector<std::pair<int, int>>> pairs;  // found by each range of cells
   std::vector<Moments> own, ring;
 
   void build(const WorldCloud& cloud, float inv_voxel) {
@@ -120,41 +123,60 @@ struct Voxels {
       }
       return out;
     }();
-    // Each pair is found once per pair of their cells: counted, filled at
-    // both ends, then each list sorted (ascending, the order growth offers
-    // them in) and its repeats (a joined voxel's two cells) dropped.
-    pairs.clear();
+    // Each pair is found once per pair of their cells (ranges of cells in
+    // parallel), counted, filled at both ends; then each list sorted
+    // (ascending, the order growth offers them in, whatever order the pairs
+    // came in) and its repeats (a joined voxel's two cells) dropped.
+    constexpr std::size_t kChunks = 16;
+    pairs.resize(kChunks);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t chunk = r.begin(); chunk < r.end(); ++chunk) {
+        std::vector<std::pair<int, int>>& found = pairs[chunk];
+        found.clear();
+        const std::size_t end = owners.size() * (chunk + 1) / kChunks;
+        for (std::size_t o = owners.size() * chunk / kChunks; o < end; ++o) {
+          const auto& [c, i] = owners[o];
+          for (const Eigen::Vector3i& d : kForward) {
+            const int j = map.find(cell_key(c + d));
+            if (j >= 0 && j != i) found.emplace_back(i, j);
+          }
+        }
+      }
+    });
     first.assign(n + 1, 0);
-    for (const auto& [c, i] : owners) {
-      for (const Eigen::Vector3i& d : kForward) {
-        const int j = map.find(cell_key(c + d));
-        if (j < 0 || j == i) continue;
-        pairs.emplace_back(i, j);
+    for (const auto& found : pairs) {
+      for (const auto& [i, j] : found) {
         ++first[static_cast<std::size_t>(i) + 1];
         ++first[static_cast<std::size_t>(j) + 1];
       }
     }
     for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
-    neighbours.resize(2 * pairs.size());
+    neighbours.resize(static_cast<std::size_t>(first[n]));
     fill.assign(first.begin(), first.end() - 1);
-    for (const auto& [i, j] : pairs) {
-      neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(i)]++)] = j;
-      neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = i;
+    for (const auto& found : pairs) {
+      for (const auto& [i, j] : found) {
+        neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(i)]++)] = j;
+        neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = i;
+      }
     }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        const auto begin = neighbours.begin() + first[i];
+        const auto end = neighbours.begin() + first[i + 1];
+        for (auto a = begin + 1; a < end; ++a) {  // insertion sort: a few tens at most
+          const int x = *a;
+          auto b = a;
+          for (; b != begin && *(b - 1) > x; --b) *b = *(b - 1);
+          *b = x;
+        }
+        fill[i] = static_cast<int>(std::unique(begin, end) - begin);  // the list's length
+      }
+    });
     int kept = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const auto begin = neighbours.begin() + first[i];
-      const auto end = neighbours.begin() + first[i + 1];
-      for (auto a = begin + 1; a < end; ++a) {  // insertion sort: a few tens at most
-        const int x = *a;
-        auto b = a;
-        for (; b != begin && *(b - 1) > x; --b) *b = *(b - 1);
-        *b = x;
-      }
+      const int from = first[i];
       first[i] = kept;
-      for (auto a = begin; a != end; ++a) {
-        if (a == begin || *a != *(a - 1)) neighbours[static_cast<std::size_t>(kept++)] = *a;
-      }
+      for (int a = 0; a < fill[i]; ++a) neighbours[static_cast<std::size_t>(kept++)] = neighbours[static_cast<std::size_t>(from + a)];
     }
     first[n] = kept;
     neighbours.resize(static_cast<std::size_t>(kept));
@@ -249,32 +271,38 @@ struct Voxels {
     const Eigen::Vector3f origin = features[0].position;  // small numbers: no cancellation
     own.resize(n);
     ring.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    // Each voxel's sums are its own: the three passes run over ranges of voxels in parallel.
+    const auto in_parallel = [n](const auto& pass) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) pass(i);
+      });
+    };
+    in_parallel([&](std::size_t i) {
       const Eigen::Vector3d p = (features[i].position - origin).cast<double>();
       own[i] << 1.0, p.x(), p.y(), p.z(), p.x() * p.x(), p.x() * p.y(), p.x() * p.z(), p.y() * p.y(),
           p.y() * p.z(), p.z() * p.z();
-    }
-    for (std::size_t i = 0; i < n; ++i) {  // the voxel and its neighbours
+    });
+    in_parallel([&](std::size_t i) {  // the voxel and its neighbours
       ring[i] = own[i];
       for (int a = first[i]; a < first[i + 1]; ++a) ring[i] += own[static_cast<std::size_t>(neighbours[static_cast<std::size_t>(a)])];
-    }
+    });
     // The voxel, and for each neighbour: itself and its neighbours.
-    for (std::size_t i = 0; i < n; ++i) {
+    in_parallel([&](std::size_t i) {
       Moments m = own[i];
       for (int a = first[i]; a < first[i + 1]; ++a) m += ring[static_cast<std::size_t>(neighbours[static_cast<std::size_t>(a)])];
       Feature& f = features[i];
       f.normal.setZero();
-      if (m(0) < 3.0) continue;
+      if (m(0) < 3.0) return;
       const Eigen::Vector3d mean = m.segment<3>(1) / m(0);
       Eigen::Matrix3d covariance;
       covariance << m(4), m(5), m(6), m(5), m(7), m(8), m(6), m(8), m(9);
       covariance = covariance / m(0) - mean * mean.transpose();
       const std::optional<Eigen::Vector3d> axis = smallest_axis(covariance);
-      if (!axis) continue;
+      if (!axis) return;
       Eigen::Vector3f normal = axis->cast<float>();
       if (normal.dot(camera - f.position) < 0.0f) normal = -normal;
       f.normal = normal;
-    }
+    });
   }
 };
 
@@ -294,7 +322,7 @@ struct Vccs::Scratch {
   std::vector<Growing> growing;
   std::vector<int> owner;
   std::vector<float> best;
-  std::vector<int> taken, listed, renumber, seen, touching;
+  std::vector<int> taken, listed, offered, renumber, seen, touching;
 };
 
 Vccs::Vccs() : scratch_(std::make_unique<Scratch>()) {}
@@ -310,8 +338,8 @@ void Vccs::run(const WorldCloud& cloud, const SupervoxelSettings& settings, cons
   const auto seed = static_cast<float>(settings.seed_resolution);
   const Eigen::Vector3f eye = camera.cast<float>();
 
-  auto& [v, seed_cells, candidates, candidate_distance, growing, owner, best, taken, listed, renumber, seen,
-         touching] = *scratch_;
+  auto& [v, seed_cells, candidates, candidate_distance, growing, owner, best, taken, listed, offered, renumber,
+         seen, touching] = *scratch_;
 
   // 1-2. Voxels, neighbours, normals.
   v.build(cloud, 1.0f / voxel);
@@ -355,16 +383,22 @@ void Vccs::run(const WorldCloud& cloud, const SupervoxelSettings& settings, cons
                   static_cast<float>(settings.spatial_importance), 1.0f / seed};
   const int depth = static_cast<int>(1.8f * seed / voxel);
   listed.assign(n, 0);  // the last round whose compaction kept the voxel
+  // A voxel a supervoxel's turn offered and did not take has the same
+  // distance and best on its next offer in that turn: it is offered once.
+  offered.assign(n, 0);
+  int turn = 0;
   for (int round = 1; round < depth; ++round) {
     for (std::size_t s = 0; s < growing.size(); ++s) {
       Growing& g = growing[s];
       const int self = static_cast<int>(s);
+      ++turn;
       taken.clear();
       for (const int i : g.voxels) {
         if (owner[static_cast<std::size_t>(i)] != self) continue;  // taken by another this round
         for (int a = v.first[static_cast<std::size_t>(i)]; a < v.first[static_cast<std::size_t>(i) + 1]; ++a) {
           const auto j = static_cast<std::size_t>(v.neighbours[static_cast<std::size_t>(a)]);
-          if (owner[j] == self) continue;
+          if (owner[j] == self || offered[j] == turn) continue;
+          offered[j] = turn;
           const float d = w.distance(g.centre, v.features[j]);
           if (d < best[j]) {
             best[j] = d;

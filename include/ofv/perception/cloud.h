@@ -18,10 +18,6 @@
 
 namespace ofv::perception {
 
-namespace detail {
-class CellMap;
-}
-
 /// \brief The working volume: points outside it are dropped before anything else.
 struct CropVolume {
   /// Keep points inside this world-frame axis-aligned box [m] (empty box: no box test).
@@ -83,14 +79,9 @@ class CloudBuilder {
   [[nodiscard]] const CloudSettings& settings() const { return settings_; }
 
  private:
-  struct Accumulator {
-    Eigen::Vector3f sum_point;
-    Eigen::Vector3f sum_colour;
-    int count;
-  };
+  struct Scratch;  // buffers kept from frame to frame
   CloudSettings settings_;
-  std::unique_ptr<detail::CellMap> cell_of_key_;  // voxel key -> index in cells_
-  std::vector<Accumulator> cells_;
+  std::unique_ptr<Scratch> scratch_;
 };
 
 /// \brief Checks that a frame's depth and colour buffers match its intrinsics,
