@@ -9,10 +9,12 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <map>
+#include <unordered_map>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -77,27 +79,42 @@ std::uint16_t label_of(const Body& b, int occluder_index) {
   return kLabelNone;
 }
 
-// Cells of an r_seed grid: mean position and mean normal per cell, in a fixed order.
+// Cells of an r_seed grid: mean position and mean normal per cell (sums in
+// the points' order), cells in the lexicographic order of their indices.
 void grid_cells(const std::vector<WorldPoint>& pts, double cell, Eigen::Matrix3Xd& positions,
                 Eigen::Matrix3Xd* normals) {
-  std::map<std::array<long, 3>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> cells;
-  std::map<std::array<long, 3>, int> counts;
+  using Key = std::array<long, 3>;
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      return static_cast<std::size_t>((static_cast<std::uint64_t>(k[0]) * 0x9E3779B97F4A7C15ull) ^
+                                      (static_cast<std::uint64_t>(k[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                                      (static_cast<std::uint64_t>(k[2]) * 0x165667B19E3779F9ull));
+    }
+  };
+  struct Cell {
+    Key key;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+    int count = 0;
+  };
+  std::vector<Cell> cells;
+  std::unordered_map<Key, std::size_t, Hash> index;
+  index.reserve(pts.size());
   for (const auto& w : pts) {
-    const std::array<long, 3> key{static_cast<long>(std::floor(w.p.x() / cell)),
-                                  static_cast<long>(std::floor(w.p.y() / cell)),
-                                  static_cast<long>(std::floor(w.p.z() / cell))};
-    auto& c = cells.try_emplace(key, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()).first->second;
-    c.first += w.p;
-    c.second += w.n;
-    ++counts[key];
+    const Key key{static_cast<long>(std::floor(w.p.x() / cell)), static_cast<long>(std::floor(w.p.y() / cell)),
+                  static_cast<long>(std::floor(w.p.z() / cell))};
+    const auto [it, inserted] = index.try_emplace(key, cells.size());
+    if (inserted) cells.push_back({key});
+    Cell& c = cells[it->second];
+    c.position += w.p;
+    c.normal += w.n;
+    ++c.count;
   }
+  std::sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
   positions.resize(3, static_cast<Eigen::Index>(cells.size()));
   if (normals != nullptr) normals->resize(3, static_cast<Eigen::Index>(cells.size()));
-  Eigen::Index k = 0;
-  for (const auto& [key, c] : cells) {
-    positions.col(k) = c.first / counts[key];
-    if (normals != nullptr) normals->col(k) = c.second.normalized();
-    ++k;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    positions.col(static_cast<Eigen::Index>(k)) = cells[k].position / cells[k].count;
+    if (normals != nullptr) normals->col(static_cast<Eigen::Index>(k)) = cells[k].normal.normalized();
   }
 }
 

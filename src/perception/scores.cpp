@@ -57,6 +57,8 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
   // Votes per cell: (label, count) pairs, a handful per cell at most.
   std::vector<std::vector<std::pair<std::uint16_t, int>>> votes;
   std::vector<int> counts;
+  std::uint64_t last_key = ~std::uint64_t{0};  // neighbouring pixels mostly share a cell
+  std::size_t current = 0;  // its cell
   for (int v = 0; v < k.height; v += stride) {
     for (int u = 0; u < k.width; u += stride) {
       const std::size_t i = frame.index(u, v);
@@ -64,13 +66,18 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
       if (!(z > 0.0f) || !std::isfinite(z) || z > static_cast<float>(max_depth)) continue;
       const Eigen::Vector3f pc(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
       const Eigen::Vector3f pw = wRc * pc + wtc;
-      const auto [it, inserted] = index_.try_emplace(detail::cell_key(cell_of(pw, inv_voxel_)), static_cast<int>(cells_.size()));
-      if (inserted) {
-        cells_.emplace_back();
-        votes.emplace_back();
-        counts.push_back(0);
+      const std::uint64_t key = detail::cell_key(cell_of(pw, inv_voxel_));
+      if (key != last_key) {
+        const auto [it, inserted] = index_.try_emplace(key, static_cast<int>(cells_.size()));
+        if (inserted) {
+          cells_.emplace_back();
+          votes.emplace_back();
+          counts.push_back(0);
+        }
+        last_key = key;
+        current = static_cast<std::size_t>(it->second);
       }
-      const auto c = static_cast<std::size_t>(it->second);
+      const std::size_t c = current;
       cells_[c].mean += pw;
       ++counts[c];
       auto& vote = votes[c];
