@@ -68,8 +68,8 @@ class CloudBuilder {
   /// \throws std::invalid_argument if `pixel_stride` < 1.
   explicit CloudBuilder(const CloudSettings& settings = {});
   ~CloudBuilder();
-  CloudBuilder(CloudBuilder&&) noexcept;
-  CloudBuilder& operator=(CloudBuilder&&) noexcept;
+  CloudBuilder(CloudBuilder&&) noexcept;             ///< moves the settings and the buffers
+  CloudBuilder& operator=(CloudBuilder&&) noexcept;  ///< moves the settings and the buffers
 
   /// \brief Fills `out` from `frame` cropped to `crop`.
   /// \throws std::invalid_argument if the frame's image sizes disagree with its intrinsics.
