@@ -3,10 +3,8 @@
 
 #include "ofv/estimator.h"
 
+#include "parallel.h"
 #include "point_grid.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <cmath>
 #include <sstream>
@@ -111,30 +109,28 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
   s.cropped.resize(rows);
 
   // 1. Every sampled pixel's world point and voxel, rows in parallel.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, 8), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t r = range.begin(); r < range.end(); ++r) {
-      const int v = static_cast<int>(r) * stride;
-      const float yn = (static_cast<float>(v) - cy) * inv_fy;
-      std::size_t valid = 0, cropped = 0;
-      for (std::size_t c = 0; c < cols; ++c) {
-        const int u = static_cast<int>(c) * stride;
-        std::uint64_t& key = s.keys[r * cols + c];
-        key = Scratch::kDropped;
-        const float z = frame.depth[frame.index(u, v)];
-        if (!(z > 0.0f) || !std::isfinite(z)) continue;
-        ++valid;
-        if (z > max_depth) continue;
-        const Eigen::Vector3f pc((static_cast<float>(u) - cx) * inv_fx * z, yn * z, z);
-        const Eigen::Vector3f pw = wRc * pc + wtc;
-        if (use_box && ((pw.array() < box_min.array()).any() || (pw.array() > box_max.array()).any())) continue;
-        if (use_sphere && (pw - centre).squaredNorm() > radius2) continue;
-        ++cropped;
-        s.points[r * cols + c] = pw;
-        key = voxelise ? detail::cell_key((pw * inv_res).array().floor().cast<int>()) : 0;
-      }
-      s.valid[r] = valid;
-      s.cropped[r] = cropped;
+  detail::for_each_index(rows, 8, [&](std::size_t r) {
+    const int v = static_cast<int>(r) * stride;
+    const float yn = (static_cast<float>(v) - cy) * inv_fy;
+    std::size_t valid = 0, cropped = 0;
+    for (std::size_t c = 0; c < cols; ++c) {
+      const int u = static_cast<int>(c) * stride;
+      std::uint64_t& key = s.keys[r * cols + c];
+      key = Scratch::kDropped;
+      const float z = frame.depth[frame.index(u, v)];
+      if (!(z > 0.0f) || !std::isfinite(z)) continue;
+      ++valid;
+      if (z > max_depth) continue;
+      const Eigen::Vector3f pc((static_cast<float>(u) - cx) * inv_fx * z, yn * z, z);
+      const Eigen::Vector3f pw = wRc * pc + wtc;
+      if (use_box && ((pw.array() < box_min.array()).any() || (pw.array() > box_max.array()).any())) continue;
+      if (use_sphere && (pw - centre).squaredNorm() > radius2) continue;
+      ++cropped;
+      s.points[r * cols + c] = pw;
+      key = voxelise ? detail::cell_key((pw * inv_res).array().floor().cast<int>()) : 0;
     }
+    s.valid[r] = valid;
+    s.cropped[r] = cropped;
   });
   for (std::size_t r = 0; r < rows; ++r) {
     out.valid_pixels += s.valid[r];

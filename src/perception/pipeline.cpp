@@ -3,9 +3,7 @@
 // classified into the ViewProblem. The stages live in the files named in
 // front_end.h.
 #include "front_end.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "parallel.h"
 
 #include <chrono>
 #include <stdexcept>
@@ -103,25 +101,15 @@ void Perception::Impl::adjacency(PerceptionResult& r) {
   }
   grid.build(centroids, r_adj);
   const auto r2 = static_cast<float>(r_adj * r_adj);
-  // Ranges of supervoxels in parallel, their pairs joined in order: (i, j)
-  // by i, then as the grid lists j.
-  constexpr std::size_t kChunks = 16;
-  adjacency_found.resize(kChunks);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kChunks, 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t chunk = range.begin(); chunk < range.end(); ++chunk) {
-      std::vector<std::pair<int, int>>& found = adjacency_found[chunk];
-      found.clear();
-      const std::size_t end = centroids.size() * (chunk + 1) / kChunks;
-      for (std::size_t i = centroids.size() * chunk / kChunks; i < end; ++i) {
-        grid.for_each_near(centroids[i], [&](int j) {
-          if (static_cast<std::size_t>(j) > i &&
-              (centroids[static_cast<std::size_t>(j)] - centroids[i]).squaredNorm() <= r2) {
-            found.emplace_back(static_cast<int>(i), j);
-          }
-        });
+  // Pairs (i, j) by i, then as the grid lists j.
+  const auto near = [&](std::size_t i, std::vector<std::pair<int, int>>& found) {
+    grid.for_each_near(centroids[i], [&](int j) {
+      if (static_cast<std::size_t>(j) > i && (centroids[static_cast<std::size_t>(j)] - centroids[i]).squaredNorm() <= r2) {
+        found.emplace_back(static_cast<int>(i), j);
       }
-    }
-  });
+    });
+  };
+  detail::collect_in_parallel(centroids.size(), adjacency_found, near);
   for (const auto& found : adjacency_found) r.adjacency.insert(r.adjacency.end(), found.begin(), found.end());
   r.counts.adjacency_edges = r.adjacency.size();
 }

@@ -2,10 +2,8 @@
 // in vccs.h). No PCL here.
 #include "vccs.h"
 
+#include "parallel.h"
 #include "point_grid.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -127,20 +125,11 @@ struct Voxels {
     // parallel), counted, filled at both ends; then each list sorted
     // (ascending, the order growth offers them in, whatever order the pairs
     // came in) and its repeats (a joined voxel's two cells) dropped.
-    constexpr std::size_t kChunks = 16;
-    pairs.resize(kChunks);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kChunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t chunk = r.begin(); chunk < r.end(); ++chunk) {
-        std::vector<std::pair<int, int>>& found = pairs[chunk];
-        found.clear();
-        const std::size_t end = owners.size() * (chunk + 1) / kChunks;
-        for (std::size_t o = owners.size() * chunk / kChunks; o < end; ++o) {
-          const auto& [c, i] = owners[o];
-          for (const Eigen::Vector3i& d : kForward) {
-            const int j = map.find(cell_key(c + d));
-            if (j >= 0 && j != i) found.emplace_back(i, j);
-          }
-        }
+    collect_in_parallel(owners.size(), pairs, [&](std::size_t o, std::vector<std::pair<int, int>>& found) {
+      const auto& [c, i] = owners[o];
+      for (const Eigen::Vector3i& d : kForward) {
+        const int j = map.find(cell_key(c + d));
+        if (j >= 0 && j != i) found.emplace_back(i, j);
       }
     });
     first.assign(n + 1, 0);
@@ -159,18 +148,16 @@ struct Voxels {
         neighbours[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = i;
       }
     }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        const auto begin = neighbours.begin() + first[i];
-        const auto end = neighbours.begin() + first[i + 1];
-        for (auto a = begin + 1; a < end; ++a) {  // insertion sort: a few tens at most
-          const int x = *a;
-          auto b = a;
-          for (; b != begin && *(b - 1) > x; --b) *b = *(b - 1);
-          *b = x;
-        }
-        fill[i] = static_cast<int>(std::unique(begin, end) - begin);  // the list's length
+    for_each_index(n, 1024, [&](std::size_t i) {
+      const auto begin = neighbours.begin() + first[i];
+      const auto end = neighbours.begin() + first[i + 1];
+      for (auto a = begin + 1; a < end; ++a) {  // insertion sort: a few tens at most
+        const int x = *a;
+        auto b = a;
+        for (; b != begin && *(b - 1) > x; --b) *b = *(b - 1);
+        *b = x;
       }
+      fill[i] = static_cast<int>(std::unique(begin, end) - begin);  // the list's length
     });
     int kept = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -272,22 +259,17 @@ struct Voxels {
     own.resize(n);
     ring.resize(n);
     // Each voxel's sums are its own: the three passes run over ranges of voxels in parallel.
-    const auto in_parallel = [n](const auto& pass) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i < r.end(); ++i) pass(i);
-      });
-    };
-    in_parallel([&](std::size_t i) {
+    for_each_index(n, 512, [&](std::size_t i) {
       const Eigen::Vector3d p = (features[i].position - origin).cast<double>();
       own[i] << 1.0, p.x(), p.y(), p.z(), p.x() * p.x(), p.x() * p.y(), p.x() * p.z(), p.y() * p.y(),
           p.y() * p.z(), p.z() * p.z();
     });
-    in_parallel([&](std::size_t i) {  // the voxel and its neighbours
+    for_each_index(n, 512, [&](std::size_t i) {  // the voxel and its neighbours
       ring[i] = own[i];
       for (int a = first[i]; a < first[i + 1]; ++a) ring[i] += own[static_cast<std::size_t>(neighbours[static_cast<std::size_t>(a)])];
     });
     // The voxel, and for each neighbour: itself and its neighbours.
-    in_parallel([&](std::size_t i) {
+    for_each_index(n, 512, [&](std::size_t i) {
       Moments m = own[i];
       for (int a = first[i]; a < first[i + 1]; ++a) m += ring[static_cast<std::size_t>(neighbours[static_cast<std::size_t>(a)])];
       Feature& f = features[i];
