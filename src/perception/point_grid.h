@@ -33,8 +33,6 @@ class CellMap {
     slots_.assign(size, Slot{});
     size_ = 0;
   }
-  /// The number of keys stored.
-  [[nodiscard]] std::size_t size() const { return size_; }
   /// The index stored for `key`, to be set by the caller when it is new (-1).
   /// The reference holds until the next insertion.
   int& find_or_insert(std::uint64_t key) {
@@ -75,7 +73,7 @@ class CellMap {
   }
   std::size_t mask_ = 0;
   int shift_ = 64;
-  std::size_t size_ = 0;
+  std::size_t size_ = 0;  // keys stored
   std::vector<Slot> slots_;
 };
 

@@ -8,6 +8,7 @@
 #include "synthetic_scene.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -218,15 +219,35 @@ TEST(Vccs, TwoTouchingBoxesOfDifferentColoursShareNoSupervoxel) {
   }
 }
 
-TEST(Vccs, TheSameFrameGivesTheSameSupervoxels) {
-  const test::SyntheticScene scene = test::table_and_case();
-  const RgbdFrame frame = scene.render(test::vga(320), test::front_camera());
-  perception::CloudBuilder builder(perception::CloudSettings{});
-  WorldCloud cloud;
-  builder.build(frame, {}, cloud);
-  ASSERT_GT(cloud.points.size(), 1000u);
-  const SupervoxelOutput a = run(cloud);
-  const SupervoxelOutput b = run(cloud);
+/// The cloud and the supervoxels of a frame are the same bit for bit on
+/// one thread and on all (the stage's loops run on oneTBB), and from a
+/// Vccs that kept its buffers from another frame.
+TEST(Vccs, TheSameFrameGivesTheSameSupervoxelsWhateverTheThreadsAndTheFramesBefore) {
+  test::SyntheticScene scene = test::table_and_case();
+  scene.shapes.push_back(test::make_capsule({0.115, -0.005, 0.03}, {0.115, -0.005, 0.12}, 0.02,
+                                            Eigen::Vector3d(225, 170, 140), test::kHand));
+  const RgbdFrame frame = scene.render(test::vga(640), test::front_camera());
+  const auto cloud_of = [&](const RgbdFrame& f) {
+    perception::CloudBuilder builder(perception::CloudSettings{});
+    WorldCloud cloud;
+    builder.build(f, {}, cloud);
+    return cloud;
+  };
+  tbb::task_arena one_thread(1);
+  WorldCloud alone;
+  one_thread.execute([&] { alone = cloud_of(frame); });
+  const WorldCloud cloud = cloud_of(frame);
+  ASSERT_GT(cloud.points.size(), 4000u);
+  EXPECT_EQ(cloud.points, alone.points);
+  EXPECT_EQ(cloud.colours, alone.colours);
+  EXPECT_EQ(cloud.cropped_points, alone.cropped_points);
+
+  SupervoxelOutput a, b;
+  one_thread.execute([&] { perception::detail::vccs_supervoxels(cloud, {}, kCamera, a); });
+  perception::detail::Vccs reused;
+  reused.run(cloud_of(test::table_and_case().render(test::vga(320), test::front_camera())), {}, kCamera, b);
+  reused.run(cloud, {}, kCamera, b);
+  ASSERT_GT(a.supervoxels.size(), 100u);
   ASSERT_EQ(a.supervoxels.size(), b.supervoxels.size());
   for (std::size_t s = 0; s < a.supervoxels.size(); ++s) {
     EXPECT_EQ(a.supervoxels[s].centroid, b.supervoxels[s].centroid);
