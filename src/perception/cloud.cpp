@@ -127,7 +127,7 @@ void CloudBuilder::build(const RgbdFrame& frame, const CropVolume& crop, WorldCl
       if (use_sphere && (pw - centre).squaredNorm() > radius2) continue;
       ++cropped;
       s.points[r * cols + c] = pw;
-      key = voxelise ? detail::cell_key((pw * inv_res).array().floor().cast<int>()) : 0;
+      key = voxelise ? detail::cell_key(pw, inv_res) : 0;
     }
     s.valid[r] = valid;
     s.cropped[r] = cropped;

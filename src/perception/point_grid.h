@@ -5,18 +5,24 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 namespace ofv::perception::detail {
 
-/// A grid cell's key: 21 bits per axis (+-8 km at 8 mm cells).
-inline std::uint64_t cell_key(const Eigen::Vector3i& c) {
-  const auto k = [](int x) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(x) + (std::int64_t{1} << 20)) & 0x1FFFFFu;
-  };
-  return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
+/// A grid cell's key from its indices: 21 bits per axis (+-8 km at 8 mm cells).
+inline std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
+  const auto k = [](std::int64_t i) { return static_cast<std::uint64_t>(i + (std::int64_t{1} << 20)) & 0x1FFFFFu; };
+  return k(x) | (k(y) << 21) | (k(z) << 42);
+}
+inline std::uint64_t cell_key(const Eigen::Vector3i& c) { return cell_key(c.x(), c.y(), c.z()); }
+/// The key of the cell of edge 1 / inv_edge that holds p (through 64-bit
+/// integers: no voxel size overflows the conversion).
+inline std::uint64_t cell_key(const Eigen::Vector3f& p, float inv_edge) {
+  const auto index = [inv_edge](float x) { return static_cast<std::int64_t>(std::floor(x * inv_edge)); };
+  return cell_key(index(p.x()), index(p.y()), index(p.z()));
 }
 
 /// Cells (keys of cell_key()) to indices: open addressing, linear probing
