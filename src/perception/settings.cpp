@@ -126,7 +126,9 @@ PerceptionSettings perception_settings(const EstimatorSettings& estimator, Perce
 
 void validate(const PerceptionSettings& s) {
   const SupervoxelSettings& sv = s.supervoxels;
-  require(positive(sv.voxel_resolution), "voxel_resolution", sv.voxel_resolution, "> 0 [m]");
+  // Cells of points within 2 kMaxLength of the origin fit the grids' 32-bit indices.
+  require(std::isfinite(sv.voxel_resolution) && sv.voxel_resolution >= 1e-4, "voxel_resolution", sv.voxel_resolution,
+          ">= 1e-4 [m]");
   require(positive(sv.seed_resolution) && sv.seed_resolution >= sv.voxel_resolution,
           "seed_resolution", sv.seed_resolution, ">= voxel_resolution [m]");
   require(std::isfinite(sv.colour_importance) && sv.colour_importance >= 0.0, "colour_importance",
@@ -154,7 +156,8 @@ void validate(const PerceptionSettings& s) {
   require(positive(s.r_sphere), "r_sphere", s.r_sphere, "> 0 [m]");
   require(std::isfinite(s.crop_margin) && s.crop_margin >= 0.0, "crop_margin", s.crop_margin,
           ">= 0 [m]");
-  require(positive(s.max_depth), "max_depth", s.max_depth, "> 0 [m]");
+  static_assert(kMaxLength == 1e4, "max_depth's message says 1e4");
+  require(positive(s.max_depth) && s.max_depth <= kMaxLength, "max_depth", s.max_depth, "in (0, 1e4] [m]");
   require(std::isfinite(s.obb_margin) && s.obb_margin >= 0.0, "obb_margin", s.obb_margin,
           ">= 0 [m]");
   require(positive(s.contact_distance), "contact_distance", s.contact_distance, "> 0 [m]");

@@ -898,6 +898,8 @@ TEST(Perception, RejectsInvalidSettings) {
   };
   throws([](perception::PerceptionSettings& s) { s.supervoxels.adjacency_alpha = 2.0; });
   throws([](perception::PerceptionSettings& s) { s.supervoxels.voxel_resolution = 0.0; });
+  throws([](perception::PerceptionSettings& s) { s.supervoxels.voxel_resolution = 1e-9; });  // cells overflow
+  throws([](perception::PerceptionSettings& s) { s.max_depth = 1e9; });
   throws([](perception::PerceptionSettings& s) { s.supervoxels.seed_resolution = 0.001; });
   throws([](perception::PerceptionSettings& s) { s.r_sphere = -1.0; });
   throws([](perception::PerceptionSettings& s) { s.contact_distance = 0.0; });

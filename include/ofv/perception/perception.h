@@ -54,7 +54,7 @@ struct SupervoxelSettings {
     Pcl,  ///< pcl::SupervoxelClustering: the reference (docs/perception.md compares them)
   };
   Method method = Method::Ofv;  ///< the implementation
-  double voxel_resolution = 0.008;  ///< voxel edge [m]
+  double voxel_resolution = 0.008;  ///< voxel edge [m], >= 1e-4
   double seed_resolution = EstimatorSettings{}.r_seed;  ///< R_seed: spacing of supervoxel seeds [m] (paper: 0.02)
   double colour_importance = 0.2;   ///< weight of colour distance in the clustering
   double spatial_importance = 0.4;  ///< weight of spatial distance
@@ -160,7 +160,7 @@ struct PerceptionSettings {
   TrackingSettings tracking;        ///< selection in the first frame, tracking from frame to frame
   double r_sphere = EstimatorSettings{}.r_sphere;  ///< R_sphere = d_pref (paper eq. 2) [m]
   double crop_margin = 0.1;  ///< crop radius = r_sphere + crop_margin around the previous C [m]
-  double max_depth = 3.0;    ///< points farther along the optical axis are dropped [m]
+  double max_depth = 3.0;    ///< points farther along the optical axis are dropped [m], at most kMaxLength
   /// The object's OBB (PCA of its voxels) grows by this on every side [m]:
   /// what lies inside it, in contact with the object (contact_distance), but
   /// is not object is interacting (a holding hand).
