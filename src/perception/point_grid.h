@@ -18,6 +18,11 @@ inline std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
   return k(x) | (k(y) << 21) | (k(z) << 42);
 }
 inline std::uint64_t cell_key(const Eigen::Vector3i& c) { return cell_key(c.x(), c.y(), c.z()); }
+/// The indices of the cell of edge 1 / inv_edge that holds p (within 32 bits
+/// for the front end's settings: voxel_resolution >= 0.1 mm, max_depth <= 1e4 m).
+inline Eigen::Vector3i cell_of(const Eigen::Vector3f& p, float inv_edge) {
+  return (p * inv_edge).array().floor().cast<int>();
+}
 /// The key of the cell of edge 1 / inv_edge that holds p (through 64-bit
 /// integers: no voxel size overflows the conversion).
 inline std::uint64_t cell_key(const Eigen::Vector3f& p, float inv_edge) {
@@ -139,9 +144,7 @@ class PointGrid {
     std::uint64_t key;
     int index;
   };
-  [[nodiscard]] Eigen::Vector3i cell_of(const Eigen::Vector3f& p) const {
-    return (p * inv_cell_).array().floor().cast<int>();
-  }
+  [[nodiscard]] Eigen::Vector3i cell_of(const Eigen::Vector3f& p) const { return detail::cell_of(p, inv_cell_); }
   static std::uint64_t key(const Eigen::Vector3i& c) { return cell_key(c); }
   float inv_cell_ = 1.0f;
   std::vector<Entry> entries_;  // sorted by key

@@ -15,10 +15,6 @@ namespace ofv::perception {
 
 namespace {
 
-Eigen::Vector3i cell_of(const Eigen::Vector3f& p, float inv_voxel) {
-  return (p * inv_voxel).array().floor().cast<int>();
-}
-
 std::optional<double> ratio(std::size_t part, std::size_t whole) {
   if (whole == 0) return std::nullopt;
   return static_cast<double>(part) / static_cast<double>(whole);
@@ -66,7 +62,7 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
       if (!(z > 0.0f) || !std::isfinite(z) || z > static_cast<float>(max_depth)) continue;
       const Eigen::Vector3f pc(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
       const Eigen::Vector3f pw = wRc * pc + wtc;
-      const std::uint64_t key = detail::cell_key(cell_of(pw, inv_voxel_));
+      const std::uint64_t key = detail::cell_key(detail::cell_of(pw, inv_voxel_));
       if (key != last_key) {
         const auto [it, inserted] = index_.try_emplace(key, static_cast<int>(cells_.size()));
         if (inserted) {
@@ -101,7 +97,7 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
 }
 
 int VoxelLabels::find(const Eigen::Vector3f& p) const {
-  const Eigen::Vector3i c = cell_of(p, inv_voxel_);
+  const Eigen::Vector3i c = detail::cell_of(p, inv_voxel_);
   if (const auto it = index_.find(detail::cell_key(c)); it != index_.end()) return it->second;
   int best = -1;
   float best_d2 = std::numeric_limits<float>::infinity();

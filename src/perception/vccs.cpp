@@ -19,10 +19,6 @@ namespace ofv::perception::detail {
 
 namespace {
 
-Eigen::Vector3i cell_of(const Eigen::Vector3f& p, float inv_edge) {
-  return (p * inv_edge).array().floor().cast<int>();
-}
-
 /// The unit eigenvector of a covariance's smallest eigenvalue, or nothing
 /// when the points lie on a line or a point (l1 l2 <= 1e-6 trace^2: the
 /// middle eigenvalue vanishes against the largest). The adjugate of C has the eigenvalues
