@@ -168,9 +168,9 @@ SettingsTable<LoopSettings> make_table() {
         },
         [](const L& l) { return std::to_string(l.tracker.max_misses); });
   t.add({"retreat_drop", "number in [0, 1]", format_number(d.retreat.drop), "",
-         "the fraction of the object the camera may see less, because it moved, than at the view that showed the "
-         "most in the last 0.5 s, before it goes back there and holds (not when occluders moved in or came there "
-         "too); the object lost soon after, it drives back there too; 0 (off) to 1"},
+         "the look-ahead's loss: where the way to the target would hide this fraction more of the object, the camera "
+         "climbs or holds (look_ahead); above 0, an object lost within 0.5 s of the view that showed the most also "
+         "sends the camera back there, to hold that view once it finds the object again until t0 is clear; 0 (both off) to 1"},
         [](L& l, const std::string& v) { l.retreat.drop = parse_number("retreat_drop", v, 0.0, 1.0, false); },
         [](const L& l) { return format_number(l.retreat.drop); });
   t.add({"look_ahead", "bool", format_bool(d.retreat.look_ahead), "",

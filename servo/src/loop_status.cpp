@@ -29,7 +29,6 @@ const char* to_string(LoopMode mode) {
 const char* to_string(Guard guard) {
   switch (guard) {
     case Guard::None: return "none";
-    case Guard::CameraCostView: return "camera_cost_view";
     case Guard::T0Clear: return "t0_clear";
     case Guard::SceneChanged: return "scene_changed";
     case Guard::ObjectLost: return "object_lost";
@@ -58,7 +57,6 @@ const char* to_string(Proposer proposer) {
 }
 const std::vector<LoopTransition>& loop_transitions() {
   static const std::vector<LoopTransition> table{
-      {LoopMode::Pursue, Guard::CameraCostView, LoopMode::Hold},
       {LoopMode::Pursue, Guard::ObjectLost, LoopMode::WayBack},
       {LoopMode::Pursue, Guard::ObjectLostNoView, LoopMode::Lost},
       {LoopMode::Hold, Guard::T0Clear, LoopMode::Pursue},

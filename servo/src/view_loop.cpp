@@ -41,36 +41,31 @@ struct ViewLoop::Impl {
         estimator(s.estimator.resolve()),
         controller(s.controller),
         safety(s.safety),
-        world(s.tracker, s.anticipation.min_speed, s.retreat.arrival, s.retreat.moved) {
+        world(s.tracker, s.anticipation.min_speed) {
     if (settings.sampling.candidates < 1 || !(settings.sampling.occluder_radius > 0.0)) {
       throw std::invalid_argument("sampling settings: candidates must be >= 1 and occluder_radius positive");
     }
     const RetreatSettings& r = settings.retreat;
-    if (!(r.drop >= 0.0 && r.drop <= 1.0) || !(r.memory > 0.0) || r.frames < 1 || r.release_frames < 1 ||
-        !(r.at >= 0.0) || !(r.arrival >= 0.0) || !(r.moved >= 0.0) || r.look_ahead_samples < 1 ||
-        !(r.climb.step_deg > 0.0) || !(r.climb.margin >= 0.0) || !(r.climb.occluder_radius > 0.0)) {
+    if (!(r.drop >= 0.0 && r.drop <= 1.0) || !(r.memory > 0.0) || !(r.at >= 0.0) || r.release_frames < 1 ||
+        r.look_ahead_samples < 1 || !(r.climb.step_deg > 0.0) || !(r.climb.margin >= 0.0) ||
+        !(r.climb.occluder_radius > 0.0)) {
       throw std::invalid_argument(
-          "retreat settings: drop in [0, 1], memory > 0 s, frames, release_frames and look_ahead_samples >= 1, "
-          "at, arrival, moved and climb.margin >= 0, climb.step_deg and climb.occluder_radius > 0");
+          "retreat settings: drop in [0, 1], memory > 0 s, at and climb.margin >= 0, release_frames and "
+          "look_ahead_samples >= 1, climb.step_deg and climb.occluder_radius > 0");
     }
   }
 
-  // A camera position (world), how much of the object it showed, the
-  // occluders seen in that frame, how long ago that was and where the
-  // occluder tracks were.
+  // A camera position (world), how much of the object it showed and how
+  // long ago that was [s].
   struct SeenView {
     Eigen::Vector3d position;
     double shown = 0.0;
-    Eigen::Matrix3Xd occluders;  // seen there, but those of tracks moving then
-    double age = 0.0;  // time since [s]
-    TrackPositions tracks;
+    double age = 0.0;
   };
 
   // What one frame brings to the stages after the world model.
   struct Frame {
-    const ViewProblem& problem;  // seen and presumed occluders
-    const OcclusionField& field;  // prepared from `problem`
-    Eigen::Index seen;            // its first `seen` occluders were seen
+    const OcclusionField& field;  // of the frame's problem: seen and presumed occluders
     const ViewEstimate& estimate;
     Eigen::Vector3d here;
     double shown;  // [m²]
@@ -87,12 +82,9 @@ struct ViewLoop::Impl {
   Candidate look_ahead(const Frame& f, const Candidate& pursuit) const;
   // --- the mode machine
   void transition(Guard guard, LoopStep& out);
-  void found(const Frame& f, LoopStep& out);
+  void remember(const Frame& f);
+  void release(const Frame& f, LoopStep& out);
   void lost(const Eigen::Vector3d& here, double dt, LoopStep& out);
-  bool camera_cost_view(const Frame& f);
-  [[nodiscard]] SeenView seen_here(const Frame& f) const {
-    return SeenView{f.here, f.shown, world.without_moving(f.problem.occluders.leftCols(f.seen)), 0.0, world.positions()};
-  }
 
   LoopSettings settings;
   EstimatorSettings estimator;
@@ -104,9 +96,8 @@ struct ViewLoop::Impl {
   LoopMode mode = LoopMode::Lost;
   std::optional<Eigen::Vector3d> previous_view, previous_target;
   std::optional<Eigen::Vector3d> last_centroid;  // C of the last frame that found the object
-  std::optional<SeenView> best_seen;  // the view that showed the most of the object
-  std::optional<SeenView> held;       // modes hold, way back, waiting: that view
-  int low_frames = 0;                 // frames in a row showing much less than best_seen or held
+  std::optional<SeenView> best_seen;  // the view that showed the most of the object (modes way back, hold: the target)
+  int low_frames = 0;                 // mode hold: frames in a row showing much less than best_seen there
   bool t0_was_clear = false;          // t0 was clear in some frame since the start
 };
 
@@ -298,94 +289,43 @@ void ViewLoop::Impl::transition(Guard guard, LoopStep& out) {
   out.guard = guard;
 }
 
-// Guard camera_cost_view (mode pursue), with the evidence it keeps: the view
-// that showed the most in the last `memory`, and the frames in a row that
-// showed `drop` less away from it. The loss must come from the
-// camera's own motion: with the occluders that stood when that view showed
-// the most (those moving then are elsewhere now, wherever the camera is),
-// and those of this frame known to stand still (revealed
-// by the motion: WorldModel::revealed_still), here shows less than there by
-// `drop` too (occluders that moved in since cost the object wherever
-// the camera is); and with this frame's occluders, that view must not show
-// less than here (they came there too).
-bool ViewLoop::Impl::camera_cost_view(const Frame& f) {
-  const RetreatSettings& s = settings.retreat;
-  const double keep = 1.0 - s.drop;
+// Mode pursue (the retreat on): the view that showed the most in the last
+// `memory`, for the way back (what a view showed longer ago is no evidence
+// any more: the occluders move).
+void ViewLoop::Impl::remember(const Frame& f) {
   if (best_seen) best_seen->age += f.dt;
-  // What a view showed longer ago than `memory` is no evidence any more
-  // (the occluders move): the current view starts again.
-  if (!best_seen || f.shown >= best_seen->shown || !(best_seen->age <= s.memory)) {
-    best_seen = seen_here(f);
-    low_frames = 0;
-    return false;
+  if (!best_seen || f.shown >= best_seen->shown || !(best_seen->age <= settings.retreat.memory)) {
+    best_seen = SeenView{f.here, f.shown};
   }
-  const bool away = (f.here - best_seen->position).norm() > s.at;
-  low_frames = away && f.shown < keep * best_seen->shown ? low_frames + 1 : 0;
-  if (low_frames < s.frames) return false;
-  const Eigen::Vector3d& c = f.estimate.centroid;
-  const double r = estimator.r_sphere;
-  const double rho = s.climb.occluder_radius;
-  const auto on_sphere = [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(c + r * (p - c).normalized()); };
-  const Eigen::Matrix3Xd still = world.revealed_still(best_seen->tracks);
-  ViewProblem then = f.problem;
-  then.occluders.resize(3, best_seen->occluders.cols() + still.cols());
-  then.occluders << best_seen->occluders, still;
-  const auto score_then = [&](const Eigen::Vector3d& p) {
-    return score_view(then, c, r, on_sphere(p), rho).visible_fraction;
-  };
-  if (!(score_then(f.here) < keep * score_then(best_seen->position))) return false;
-  return score_view(f.field, on_sphere(best_seen->position), rho).visible_fraction >=
-         score_view(f.field, on_sphere(f.here), rho).visible_fraction;
 }
 
-// The mode machine in a frame that found the object (the retreat on).
-void ViewLoop::Impl::found(const Frame& f, LoopStep& out) {
+// Mode hold, found again at best_seen after a loss: it stays there until t0
+// is clear, or until, there, `release_frames` frames in a row show `drop`
+// less than that view did (the scene changed).
+void ViewLoop::Impl::release(const Frame& f, LoopStep& out) {
   const RetreatSettings& s = settings.retreat;
-  const double keep = 1.0 - s.drop;
-  if (f.estimate.iterations == 0) t0_was_clear = true;
-  if (mode == LoopMode::WayBack || mode == LoopMode::Waiting || mode == LoopMode::Lost) {
-    transition(Guard::ObjectFound, out);
-  }
-  if (mode == LoopMode::Hold) {
-    const bool there = (f.here - held->position).norm() <= s.at;
-    low_frames = there && f.shown < keep * held->shown ? low_frames + 1 : 0;
-    Guard release = Guard::None;
-    if (f.estimate.iterations == 0) {
-      release = Guard::T0Clear;
-    } else if (low_frames >= s.release_frames) {
-      release = Guard::SceneChanged;
-    }
-    if (release == Guard::None) return;
-    transition(release, out);
-    held.reset();
-    best_seen = seen_here(f);
-    low_frames = 0;
+  const bool there = (f.here - best_seen->position).norm() <= s.at;
+  low_frames = there && f.shown < (1.0 - s.drop) * best_seen->shown ? low_frames + 1 : 0;
+  if (f.estimate.iterations == 0) {
+    transition(Guard::T0Clear, out);
+  } else if (low_frames >= s.release_frames) {
+    transition(Guard::SceneChanged, out);
+  } else {
     return;
   }
-  if (camera_cost_view(f)) {
-    transition(Guard::CameraCostView, out);
-    held = best_seen;
-    low_frames = 0;
-  }
+  best_seen.reset();  // pursue starts again from here
 }
 
 // The mode machine in a frame without the object (the retreat on).
 void ViewLoop::Impl::lost(const Eigen::Vector3d& here, double dt, LoopStep& out) {
-  if (mode == LoopMode::Pursue || mode == LoopMode::Lost) {
-    if (best_seen) best_seen->age += dt;
-    if (mode == LoopMode::Pursue) {
-      if (best_seen && best_seen->age <= settings.retreat.memory) {
-        transition(Guard::ObjectLost, out);
-        held = best_seen;
-        low_frames = 0;
-      } else {
-        transition(Guard::ObjectLostNoView, out);
-      }
-    }
+  if (best_seen) best_seen->age += dt;
+  if (mode == LoopMode::Pursue) {
+    const bool recent = best_seen && best_seen->age <= settings.retreat.memory;
+    transition(recent ? Guard::ObjectLost : Guard::ObjectLostNoView, out);
   } else if (mode == LoopMode::Hold) {
     transition(Guard::ObjectLost, out);
   }
-  const bool there = held && (here - held->position).norm() <= settings.retreat.at;
+  const bool there = best_seen && (here - best_seen->position).norm() <= settings.retreat.at;
   if (mode == LoopMode::WayBack && there) transition(Guard::BackThere, out);
   if (mode == LoopMode::Waiting && !there) transition(Guard::AwayAgain, out);
 }
@@ -422,26 +362,29 @@ LoopStep ViewLoop::Impl::step(const Observation& observation, double dt) {
       case ViewStatus::OutOfTime: out.status = StepStatus::NotConverged; break;
       default: out.status = StepStatus::NoOccluders; break;
     }
-    const Candidate pursuit = pursue(*problem, *field, out);
-    selected = pursuit;
-    if (retreat && observation.shown_area) {
-      const Frame f{*problem, *field, seen, *out.estimate, here, *observation.shown_area, dt, observation.age};
-      found(f, out);
-      if (mode == LoopMode::Pursue) selected = look_ahead(f, pursuit);
-      if (mode == LoopMode::Hold) selected = {held->position, Proposer::BestSeen};
-    } else {
-      if (mode != LoopMode::Pursue) out.guard = Guard::ObjectFound;
-      mode = LoopMode::Pursue;
+    if (mode != LoopMode::Pursue && mode != LoopMode::Hold) {
+      transition(Guard::ObjectFound, out);
+      low_frames = 0;
     }
+    selected = pursue(*problem, *field, out);
+    if (retreat && observation.shown_area) {
+      const Frame f{*field, *out.estimate, here, *observation.shown_area, dt, observation.age};
+      if (f.estimate.iterations == 0) t0_was_clear = true;
+      if (mode == LoopMode::Hold) release(f, out);
+      if (mode == LoopMode::Pursue) {
+        remember(f);
+        selected = look_ahead(f, selected);
+      }
+    }
+    if (mode == LoopMode::Hold) selected = {best_seen->position, Proposer::BestSeen};
     previous_view = out.estimate->tf;
     previous_target = selected.view;
     last_centroid = out.estimate->centroid;
   } else if (retreat && last_centroid) {
     lost(here, dt, out);
-    if (mode == LoopMode::WayBack) selected = {held->position, Proposer::BestSeen};
-  } else {
-    if (mode != LoopMode::Lost) out.guard = Guard::ObjectLostNoView;
-    mode = LoopMode::Lost;
+    if (mode == LoopMode::WayBack) selected = {best_seen->position, Proposer::BestSeen};
+  } else if (mode == LoopMode::Pursue) {
+    transition(Guard::ObjectLostNoView, out);
   }
   out.mode = mode;
   out.target = selected.view;

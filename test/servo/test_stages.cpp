@@ -74,7 +74,7 @@ Eigen::Matrix3Xd cluster(const Eigen::Vector3d& c) {
 // Two clusters, one standing at `still`, one moving from `from` at `v`, over `frames` frames.
 WorldModel watched(const Eigen::Vector3d& still, const Eigen::Vector3d& from, const Eigen::Vector3d& v, int frames,
                    double dt = 1.0 / 30.0) {
-  WorldModel world(TrackerSettings{}, /*min_speed=*/0.05, /*arrival=*/0.3, /*moved=*/0.05);
+  WorldModel world(TrackerSettings{}, /*min_speed=*/0.05);
   for (int k = 0; k < frames; ++k) {
     Eigen::Matrix3Xd seen(3, 8);
     seen << cluster(still), cluster(from + v * (k * dt));
@@ -97,42 +97,6 @@ TEST(WorldModel, PredictionsAreTheMovingTracksAheadAndInsideTheSphere) {
   const Eigen::Matrix3Xd near = world.predicted(0.3, 3, c, 0.12);
   EXPECT_LT(near.cols(), ahead.cols());
   for (Eigen::Index i = 0; i < near.cols(); ++i) EXPECT_LT((near.col(i) - c).norm(), 0.12);
-}
-
-TEST(WorldModel, RevealedStillIsWhatStoodStillSinceThenWhereverTheSceneIs) {
-  const Eigen::Vector3d still(0.0, 0.1, 0.4), from(-0.1, 0.0, 0.4), v(0.3, 0.0, 0.0);
-  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1.5, -2.0, 0.7)}) {
-    const WorldModel world = watched(still + shift, from + shift, v, 10);
-    const TrackPositions now = world.positions();
-    ASSERT_EQ(now.size(), 2U);
-    // Since the tracks' positions now: only the still cluster's points.
-    const Eigen::Matrix3Xd revealed = world.revealed_still(now);
-    ASSERT_EQ(revealed.cols(), 4);
-    for (Eigen::Index i = 0; i < revealed.cols(); ++i) {
-      EXPECT_LT((revealed.col(i) - (still + shift)).norm(), 0.02);
-    }
-    // A track that stood more than `moved` away then was not revealed by the camera.
-    TrackPositions then = now;
-    for (auto& [id, p] : then) p += Eigen::Vector3d(0.06, 0, 0);
-    EXPECT_EQ(world.revealed_still(then).cols(), 0);
-  }
-}
-
-TEST(WorldModel, WithoutMovingKeepsWhatStandsAndWhatIsNotTracked) {
-  const Eigen::Vector3d still(0.0, 0.1, 0.4), from(-0.1, 0.0, 0.4), v(0.3, 0.0, 0.0);
-  const WorldModel world = watched(still, from, v, 10);
-  // The last frame's points as update() took them, and one it never saw.
-  Eigen::Matrix3Xd seen(3, 9);
-  seen << cluster(still), cluster(from + v * (9 / 30.0)), Eigen::Vector3d(0.2, 0.2, 0.2);
-  const Eigen::Matrix3Xd kept = world.without_moving(seen);
-  ASSERT_EQ(kept.cols(), 5);
-  EXPECT_TRUE(kept.leftCols(4).isApprox(cluster(still)));
-  EXPECT_TRUE(kept.col(4).isApprox(Eigen::Vector3d(0.2, 0.2, 0.2)));
-  // Nothing moving: all of it.
-  const WorldModel calm = watched(still, from, Eigen::Vector3d::Zero(), 10);
-  Eigen::Matrix3Xd calm_seen(3, 8);
-  calm_seen << cluster(still), cluster(from);
-  EXPECT_EQ(calm.without_moving(calm_seen).cols(), 8);
 }
 
 TEST(WorldModel, APeriodThatIsNotATimeStartsTheTracksAgain) {

@@ -163,15 +163,6 @@ TEST(ViewLoop, AnticipationLeavesBeforeTheOccluderArrives) {
   EXPECT_LE(ahead + 8, reactive) << "anticipating " << ahead << ", reactive " << reactive;
 }
 
-// What hides the object once the camera has left the origin for the
-// estimator's view (a cluster in front of a corner of the patch occludes t0
-// there), while the frame shows half as much of the object.
-enum class Loss {
-  Revealed,  // a still cluster, not seen before, now blocks the patch (a false free view)
-  CameTo,    // a cluster arrived in front of the origin
-  Follows,   // a cluster that moves with the camera, between it and the patch
-};
-
 // The patch with a small cluster in front of a corner (side 1: +x +y, -1:
 // -x -y): t0 is occluded, the estimator converges to the same view frame
 // after frame.
@@ -195,106 +186,7 @@ Eigen::Vector3d stay(servo::ViewLoop& loop, int frames, double side = 1.0) {
 // A frame at the origin with nothing in front of the patch: t0 is clear.
 void see_t0_clear(servo::ViewLoop& loop) { (void)loop.step(observed(patch(false), vpHomogeneousMatrix(), 0.0, 100.0), 1.0 / 30.0); }
 
-// Three frames on the way to `away` showing `shown_on_way` (of 100 at the
-// origin); returns the last target.
-Eigen::Vector3d leave(servo::ViewLoop& loop, const Eigen::Vector3d& away, Loss loss, double shown_on_way, double side = 1.0) {
-  const Eigen::Vector3d object(0, 0, 0.5);
-  const ViewProblem start = occluded_patch(side);
-  servo::LoopStep s;
-  for (int k = 1; k <= 3; ++k) {
-    const Eigen::Vector3d camera = away * 0.3 * k;  // on its way
-    Eigen::Vector3d cluster = 0.5 * (camera + object);
-    double spacing = 0.004;
-    if (loss == Loss::Revealed) cluster = 0.7 * (away * 0.6) + 0.3 * object;  // on the way, still
-    if (loss == Loss::CameTo) cluster = Eigen::Vector3d(0, 0, 0.02);          // in front of the origin
-    ViewProblem p = start;
-    p.occluders.conservativeResize(3, 9 + 49);
-    for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = cluster + spacing * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
-    s = loop.step(observed(p, vpHomogeneousMatrix(vpTranslationVector(camera.x(), camera.y(), camera.z()), vpRotationMatrix()), 0.0, shown_on_way), 1.0 / 30.0);
-    EXPECT_TRUE(s.target);
-  }
-  return s.target.value_or(Eigen::Vector3d::Constant(NAN));
-}
-
-// `settle` frames at the origin, then three on the way to the estimator's
-// view; returns the last target.
-Eigen::Vector3d after_leaving(double retreat_drop, Loss loss, int settle = 1, double shown_on_way = 50.0) {
-  servo::LoopSettings settings;
-  settings.retreat.drop = retreat_drop;
-  servo::ViewLoop loop(settings);
-  const Eigen::Vector3d away = stay(loop, settle);
-  EXPECT_GT(away.norm(), 0.05);
-  return leave(loop, away, loss, shown_on_way);
-}
-
-TEST(ViewLoop, RetreatsWhenItsOwnMotionHidesTheObject) {
-  // Shown halved two frames in a row, 1 cm or more from the view that showed
-  // the most (the origin), because of the camera's motion (still occluders
-  // it revealed make here worse than the origin), and the frame's occluders
-  // do not make the origin worse than here: back to the origin, and hold.
-  EXPECT_LT(after_leaving(0.2, Loss::Revealed).norm(), 1e-12);
-  // Off, the occluders came to the origin too (the scene changed), or the
-  // loss comes from an occluder that moves (it would hide the object
-  // wherever the camera is): the estimator's view.
-  EXPECT_GT(after_leaving(0.0, Loss::Revealed).norm(), 0.05);
-  EXPECT_GT(after_leaving(0.2, Loss::CameTo).norm(), 0.05);
-  EXPECT_GT(after_leaving(0.2, Loss::Follows).norm(), 0.05);
-}
-
 vpHomogeneousMatrix at(const Eigen::Vector3d& p) { return vpHomogeneousMatrix(vpTranslationVector(p.x(), p.y(), p.z()), vpRotationMatrix()); }
-
-// Frames at 30 Hz: the camera at the origin (showing 100), then on its way
-// to the estimator's view (showing 40) while a cluster that stood aside
-// since the start moves in between (0.6 m/s) and stops there, in front of
-// the camera's way more than in front of the origin. Returns how many of
-// the frames after it stopped had the origin as target. `seen_before`:
-// the cluster is seen while the camera is at the origin, else it comes
-// into view when the camera leaves, `way` before where it stops.
-int retreats_after_an_arrival(bool seen_before = true, double way = 0.1) {
-  const double dt = 1.0 / 30.0;
-  servo::ViewLoop loop(servo::LoopSettings{});
-  const auto frame = [&](const Eigen::Vector3d& camera, const std::optional<Eigen::Vector3d>& cluster, double shown) {
-    ViewProblem p = occluded_patch();
-    if (cluster) {
-      p.occluders.conservativeResize(3, 9 + 49);
-      for (int i = 0; i < 49; ++i) p.occluders.col(9 + i) = *cluster + 0.006 * Eigen::Vector3d(i % 7 - 3, i / 7 - 3, 0);
-    }
-    return loop.step(observed(p, at(camera), 0.0, shown), dt);
-  };
-  Eigen::Vector3d away = stay(loop, 1).normalized();
-  // On the line of sight from where the camera stops (8 cm along `away`),
-  // 4.8 cm beside the origin's.
-  const Eigen::Vector3d stop = 0.6 * (0.08 * away) + Eigen::Vector3d(0, 0, 0.2);
-  const Eigen::Vector3d aside = stop - way * away;
-  for (int k = 0; k < 8; ++k) {
-    (void)frame(Eigen::Vector3d::Zero(), seen_before ? std::optional<Eigen::Vector3d>(aside) : std::nullopt, 100.0);
-  }
-  Eigen::Vector3d camera = Eigen::Vector3d::Zero();
-  Eigen::Vector3d cluster = aside;
-  int back = 0;
-  for (int k = 0; k < 14; ++k) {
-    camera = std::min(0.08, camera.norm() + 0.01) * away;
-    const Eigen::Vector3d to_stop = stop - cluster;
-    const bool moving = to_stop.norm() > 1e-9;
-    cluster += to_stop.norm() <= 0.02 ? to_stop : (0.02 * to_stop.normalized()).eval();
-    const servo::LoopStep s = frame(camera, cluster, 40.0);
-    if (!moving && s.target && s.target->norm() < 1e-9) ++back;
-  }
-  return back;
-}
-
-TEST(ViewLoop, AnOccluderThatArrivedAndStoppedIsNoReasonToRetreat) {
-  // The loss comes from the cluster that moved in, not from the camera's
-  // motion: once it stands still it is still not taken as revealed by the
-  // motion (it moved since the origin showed the most), so the camera keeps
-  // its way instead of going back.
-  EXPECT_EQ(retreats_after_an_arrival(), 0);
-  // Nor when it came into view only after the origin showed the most (an
-  // arm entering the image): it moved since it was first seen, or it was
-  // moving when it came into view, even if it stopped within 5 cm.
-  EXPECT_EQ(retreats_after_an_arrival(/*seen_before=*/false), 0);
-  EXPECT_EQ(retreats_after_an_arrival(/*seen_before=*/false, /*way=*/0.04), 0);
-}
 
 TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   // The origin showed the most (100); 6 cm away the frame shows 95, then
@@ -326,6 +218,7 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   s = loop.step(observed(occluded_patch(), at(Eigen::Vector3d(0.005, 0, 0)), 0.0, 100.0), dt);
   EXPECT_EQ(s.guard, servo::Guard::ObjectFound);
   EXPECT_EQ(s.mode, servo::LoopMode::Hold);
+  EXPECT_EQ(s.proposer, servo::Proposer::BestSeen);
   s = loop.step(observed(patch(false), at(Eigen::Vector3d(0.005, 0, 0)), 0.0, 100.0), dt);
   EXPECT_EQ(s.guard, servo::Guard::T0Clear);
   EXPECT_EQ(s.mode, servo::LoopMode::Pursue);
@@ -350,6 +243,33 @@ TEST(ViewLoop, LostOnItsWayItGoesBackToWhereItSawTheObject) {
   EXPECT_EQ(s.mode, servo::LoopMode::Waiting);
   EXPECT_FALSE(s.target);
   EXPECT_EQ(s.velocity.frobeniusNorm(), 0.0);
+}
+
+TEST(ViewLoop, AHoldEndsWhenTheHeldViewKeepsShowingLess) {
+  // Lost 6 cm from the origin (which showed 100), back there, found again:
+  // it holds the origin. There every frame shows 50 (the scene changed):
+  // the hold ends after release_frames such frames, not before.
+  const double dt = 1.0 / 30.0;
+  const servo::LoopSettings settings;
+  servo::ViewLoop loop(settings);
+  (void)stay(loop, 1);
+  const Eigen::Vector3d back(0.005, 0, 0);
+  (void)loop.step(observed(occluded_patch(), at(Eigen::Vector3d(0.06, 0, 0)), 0.0, 95.0), dt);
+  EXPECT_EQ(loop.step(observed(std::nullopt, at(Eigen::Vector3d(0.06, 0, 0)), 0.0), dt).mode, servo::LoopMode::WayBack);
+  EXPECT_EQ(loop.step(observed(std::nullopt, at(back), 0.0), dt).mode, servo::LoopMode::Waiting);
+  for (int k = 1; k <= settings.retreat.release_frames; ++k) {
+    const servo::LoopStep s = loop.step(observed(occluded_patch(), at(back), 0.0, 50.0), dt);
+    if (k < settings.retreat.release_frames) {
+      EXPECT_EQ(s.mode, servo::LoopMode::Hold) << k;
+      EXPECT_EQ(s.proposer, servo::Proposer::BestSeen) << k;
+      ASSERT_TRUE(s.target);
+      EXPECT_LT(s.target->norm(), 1e-12);
+    } else {
+      EXPECT_EQ(s.guard, servo::Guard::SceneChanged);
+      EXPECT_EQ(s.mode, servo::LoopMode::Pursue);
+      EXPECT_NE(s.proposer, servo::Proposer::BestSeen);
+    }
+  }
 }
 
 TEST(ViewLoop, PresumedOccludersAreAvoidedButNotTracked) {

@@ -43,15 +43,16 @@ enum class SafetyAction {
 /**
  * \brief The loop's mode after a frame: the state of ViewLoop's mode machine.
  *
- * Pursue drives to the view the proposers give; Hold keeps the view that
- * showed the most of the object in the last 0.5 s (the retreat); WayBack
- * drives back there when the object is lost; Waiting is back there with the
- * object still lost; Lost stops with no view to go back to.
+ * Pursue drives to the view the proposers give; WayBack drives back to
+ * the view that showed the most of the object in the last 0.5 s when the
+ * object is lost (the retreat); Waiting is back there with the object still
+ * lost; Hold keeps that view once the object is found again; Lost stops
+ * with no view to go back to.
  */
 enum class LoopMode {
   Pursue,   ///< to the selected view (estimate, anticipated, warm start, look-ahead)
-  Hold,     ///< at the view that showed the most, until a guard releases it
-  WayBack,  ///< the object lost: back to that view
+  Hold,     ///< found again after a loss: at the view that showed the most, until a guard releases it
+  WayBack,  ///< the object lost: back to the view that showed the most of it
   Waiting,  ///< the object lost, back at that view: stopped, perception looks for it there
   Lost,     ///< the object lost with no recent view to go back to: stopped
 };
@@ -61,16 +62,15 @@ enum class LoopMode {
 /// \brief The guard of the mode machine that moved the loop in a frame.
 enum class Guard {
   None,            ///< no transition
-  CameraCostView,  ///< pursue → hold: the camera's own motion cost retreat_drop of what that view showed
   T0Clear,         ///< hold → pursue: t0 is clear
-  SceneChanged,    ///< hold → pursue: back there, it keeps showing retreat_drop less (the scene changed)
-  ObjectLost,      ///< pursue | hold → way back: the object lost within 0.5 s of that view, or while holding
+  SceneChanged,    ///< hold → pursue: there, it keeps showing retreat_drop less than that view did
+  ObjectLost,      ///< pursue | hold → way back: the object lost within 0.5 s of the view that showed the most, or while holding
   ObjectLostNoView,  ///< pursue → lost: the object lost with no such view
   BackThere,       ///< way back → waiting
   AwayAgain,       ///< waiting → way back
   ObjectFound,     ///< way back | waiting → hold; lost → pursue (then that mode's guards, the same frame)
 };
-/// \brief The word in files and on the terminal, e.g. camera_cost_view, t0_clear.
+/// \brief The word in files and on the terminal, e.g. object_lost, t0_clear.
 [[nodiscard]] const char* to_string(Guard guard);
 
 /// \brief One transition of the mode machine: in mode `from`, guard `guard` moves the loop to `to`.
@@ -91,7 +91,7 @@ enum class Proposer {
   WarmStart,    ///< continued from the previous target while t0 is occluded (target_hysteresis)
   Climb,        ///< look-ahead: a nearby view that sees clearly more (most_visible_view)
   Here,         ///< look-ahead: the camera's own view (it holds where it is)
-  BestSeen,     ///< the view that showed the most of the object (modes hold and way back)
+  BestSeen,     ///< the view that showed the most of the object (modes way back and hold)
   InitialView,  ///< baseline method initial_view: t0
   Sampling,     ///< baseline method sampling
   Plan,         ///< method hindsight: the planned path (ViewLoop::follow)

@@ -79,43 +79,35 @@ struct AnticipationSettings {
 };
 
 /**
- * \brief The retreat (ViewLoop's modes hold and way back) and the look-ahead
- *        (mode pursue); both need the frame's shown area (Observation::shown_area).
+ * \brief The retreat (ViewLoop's modes way back, waiting and hold) and the
+ *        look-ahead (mode pursue); both need the frame's shown area
+ *        (Observation::shown_area).
  *
- * A view can look free only because the sensor does not see the occluders
- * behind the ones in front. So the loop remembers the camera position that
- * showed the most of the object in the last `memory`. When the camera has
- * moved `at` or more away from it and shows `drop` of that less for `frames`
- * frames, because of its own motion (with the occluders seen in that
- * position's frame and this frame's still ones that did not come into view
- * moving and have not moved `moved` since, score_view shows `drop` less
- * here than there), and this frame's occluders do not make that position
- * worse than the current one, the camera goes back there and holds (guard
- * camera_cost_view) until t0 is clear (t0_clear) or, back there, it shows
- * `drop` less for `release_frames` frames in a row (scene_changed). When
- * perception loses the object within `memory` of that position, or during a
- * hold, the camera drives back there and stops (way back, waiting).
+ * Way back: the loop remembers the camera position that showed the most of
+ * the object in the last `memory`; when perception loses the object within
+ * `memory` of that frame, the camera drives back there (within `at`) and
+ * stops until the object is found again. Found again, it holds that view
+ * until t0 is clear or, there, `release_frames` frames in a row show `drop`
+ * less of the object than that view did (the scene changed).
  *
  * Look-ahead, until t0 has been clear in some frame (what hides the object
- * was there from the start and stands still, like a cage): the camera does
- * not go on towards its target when, on the way (`look_ahead_samples` points on the
- * great circle, the last as far as it can travel before a frame shows a
- * loss and it stops: max_linear_speed x (frame age + one period) plus the
- * braking distance), score_view with the frame's occluders shows `drop`
- * less of the object than here; it climbs to a nearby view that sees
- * clearly more (most_visible_view with `climb`) if the way there keeps what
- * it sees, else it holds where it is. Once t0 has been clear, what hides
- * the object came in and may stand on the way out (an arm stopped over the
- * object), where holding would keep the camera there.
+ * was there from the start and stands still, like a cage; a view can look
+ * free only because the sensor does not see the occluders behind the ones
+ * in front): the camera does not go on towards its target when, on the way
+ * (`look_ahead_samples` points on the great circle, the last as far as it
+ * can travel before a frame shows a loss and it stops: max_linear_speed x
+ * (frame age + one period) plus the braking distance), score_view with the
+ * frame's occluders shows `drop` less of the object than here; it climbs to
+ * a nearby view that sees clearly more (most_visible_view with `climb`) if
+ * the way there keeps what it sees, else it holds where it is. Once t0 has
+ * been clear, what hides the object came in and may stand on the way out
+ * (an arm stopped over the object), where holding would keep the camera there.
  */
 struct RetreatSettings {
   double drop = 0.1;       ///< setting retreat_drop: the loss that counts, a fraction; 0 = retreat and look-ahead off
   double memory = 0.5;     ///< what a view showed counts as evidence this long [s]
-  int frames = 2;          ///< a loss counts when it lasts this many frames (one frame is noise)
-  int release_frames = 6;  ///< back at the held view, this many frames showing `drop` less end the hold
   double at = 0.01;        ///< the camera is at a view within this distance [m]
-  double arrival = 0.3;    ///< a track moving this soon after it was first seen came into view moving [s]
-  double moved = 0.05;     ///< a still track that moved farther than this since a view was not revealed by the camera [m]
+  int release_frames = 6;  ///< at the held view, this many frames showing `drop` less end the hold
   bool look_ahead = true;  ///< setting look_ahead
   int look_ahead_samples = 3;  ///< points scored on the way
   MostVisibleSettings climb;   ///< the look-ahead's climb; its margin is setting look_ahead_margin
@@ -141,7 +133,7 @@ struct LoopSettings {
   bool target_hysteresis = true;
   AnticipationSettings anticipation;  ///< how the loop looks ahead at moving occluders
   TrackerSettings tracker;           ///< the occluder tracks anticipation uses
-  RetreatSettings retreat;           ///< modes hold and way back, and the look-ahead of mode pursue
+  RetreatSettings retreat;           ///< modes way back, waiting and hold, and the look-ahead of mode pursue
 };
 
 /**
