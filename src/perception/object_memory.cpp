@@ -273,7 +273,8 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
   // outward (m) over the pixels while they show the surface; the last one is
   // the edge. nullopt when what lies beyond is nearer the camera (an
   // occluder cuts the object there: the last surface point and how much
-  // nearer the occluder is go to `cut`) or the walk leaves the image.
+  // nearer the occluder is go to `cut`; the object's own nearer part is no
+  // cut) or the walk leaves the image.
   const auto edge = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& m,
                         std::optional<std::pair<Eigen::Vector3f, double>>& cut) -> std::optional<Eigen::Vector3f> {
     double z0 = 0.0;
@@ -307,7 +308,12 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
         continue;
       }
       if (d < expected - in_front) {  // occluded edge
-        cut.emplace(last ? *last : p.cast<float>(), expected - d);
+        // By the object's own nearer part (a cloth's fold), no occluder cuts it.
+        const Eigen::Vector3d pc((px.x() - k.cx) * d / k.fx, (px.y() - k.cy) * d / k.fy, d);
+        const Eigen::Vector3f q = (frame.wMc * pc).cast<float>();
+        if (!moved_grid.any_within(q, neighbourhood, [](int) { return true; })) {
+          cut.emplace(last ? *last : p.cast<float>(), expected - d);
+        }
         return std::nullopt;
       }
       if (!last) return std::nullopt;

@@ -819,6 +819,26 @@ TEST(Perception, AnObjectCutFromTheStartGoesOnBehindTheOccluder) {
   EXPECT_EQ(rc.counts.presumed_voxels, 0U);
 }
 
+// The case folded over itself: a flap of its own colour, joined to its
+// left edge, stands 3 cm in front of its left third. The flap hides part of
+// the case, but it is the object, not an occluder: nothing is presumed
+// behind it (with a board of another colour there, the case is presumed to
+// go on behind, above).
+TEST(Perception, AnObjectsOwnFoldIsNoCut) {
+  test::SyntheticScene folded = test::table_and_case();
+  const Eigen::Vector3d colour(40, 60, 200);
+  folded.shapes.push_back(test::make_box({-0.065, -0.04, 0.0675}, {0.06, 0.006, 0.135}, colour, kObject));
+  folded.shapes.push_back(test::make_box({-0.092, -0.024, 0.0675}, {0.006, 0.033, 0.135}, colour, kObject));
+  perception::Perception p{perception::PerceptionSettings{}};
+  const Frame f = render(folded, test::front_camera());
+  const perception::PerceptionResult r = p.process(f.frame);
+  ASSERT_EQ(r.status, perception::TrackingStatus::Initialised) << r.message;
+  const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
+  ASSERT_GE(score.recall, 0.9);  // the flap is part of the object found
+  EXPECT_EQ(r.counts.presumed_voxels, 0U);
+  EXPECT_EQ(r.counts.hidden_vertices, 0U);
+}
+
 TEST(Perception, BoxAndImageSelectionsPickTheCase) {
   const Eigen::Isometry3d wMc = test::front_camera();
   test::SyntheticScene scene = test::table_and_case();
