@@ -54,6 +54,12 @@ inline std::optional<Eigen::Vector2d> project(const RgbdFrame& frame, const Eige
   return Eigen::Vector2d(k.fx * pc.x() / pc.z() + k.cx, k.fy * pc.y() / pc.z() + k.cy);
 }
 
+/// World point seen at pixel (u, v) with depth `depth` [m] (project()'s inverse).
+inline Eigen::Vector3d unproject(const RgbdFrame& frame, double u, double v, double depth) {
+  const CameraIntrinsics& k = frame.intrinsics;
+  return frame.wMc * Eigen::Vector3d((u - k.cx) * depth / k.fx, (v - k.cy) * depth / k.fy, depth);
+}
+
 /// What the frame shows of world point p.
 enum class Sight {
   Shown,    ///< its pixel's depth is at p or behind it

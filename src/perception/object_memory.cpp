@@ -77,7 +77,6 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   //   touches the object through a neighbour of the object's colour.
   const Eigen::Isometry3d cMw = previous.wMc.inverse();
   const Eigen::Vector3d eye = previous.wMc.translation();
-  const CameraIntrinsics& k = previous.intrinsics;
   std::vector<int> seen_before(n, 0);  // voxels the previous frame showed where they are, not edge-on
   std::vector<int> revealed(n, 0);     // voxels the object hid from it
   std::vector<int> unseen(n, 0);       // voxels beyond its image or edge-on to it
@@ -91,8 +90,7 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
     if (l && !l->measured()) continue;  // a drop-out tells nothing
     const double d = l ? static_cast<double>(l->observed) : 0.0;
     if (l && d < l->z - t.max_motion) {
-      const Eigen::Vector3f hider =
-          (previous.wMc * Eigen::Vector3d((l->u - k.cx) * d / k.fx, (l->v - k.cy) * d / k.fy, d)).cast<float>();
+      const Eigen::Vector3f hider = detail::unproject(previous, l->u, l->v, d).cast<float>();
       if (remembered_near(hider, res, chroma(sv.colours[i]))) {
         voxel_state[i] = 1;
         ++revealed[owner];
@@ -301,16 +299,14 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
       const double expected = z0 + (z1 - z0) * static_cast<double>(s) / pixels_per_voxel;
       const auto d = static_cast<double>(observed);
       if (std::abs(d - expected) <= in_front && std::abs(d - z_last) <= in_front) {
-        const Eigen::Vector3d pc((px.x() - k.cx) * d / k.fx, (px.y() - k.cy) * d / k.fy, d);
-        last = (frame.wMc * pc).cast<float>();
+        last = detail::unproject(frame, px.x(), px.y(), d).cast<float>();
         z_last = d;
         s_last = s;
         continue;
       }
       if (d < expected - in_front) {  // occluded edge
         // By the object's own nearer part (a cloth's fold), no occluder cuts it.
-        const Eigen::Vector3d pc((px.x() - k.cx) * d / k.fx, (px.y() - k.cy) * d / k.fy, d);
-        const Eigen::Vector3f q = (frame.wMc * pc).cast<float>();
+        const Eigen::Vector3f q = detail::unproject(frame, px.x(), px.y(), d).cast<float>();
         if (!moved_grid.any_within(q, neighbourhood, [](int) { return true; })) {
           cut.emplace(last ? *last : p.cast<float>(), expected - d);
         }
@@ -565,8 +561,7 @@ void Perception::Impl::behind_occluders(const RgbdFrame& frame, PerceptionResult
       // Not into or behind the support plane, nor hidden by it.
       if (plane) {
         const auto d = static_cast<double>(observed);
-        const Eigen::Vector3d hider =
-            frame.wMc * Eigen::Vector3d((px->x() - k.cx) * d / k.fx, (px->y() - k.cy) * d / k.fy, d);
+        const Eigen::Vector3d hider = detail::unproject(frame, px->x(), px->y(), d);
         const double side = plane->head<3>().dot(q.cast<double>()) + (*plane)(3);
         if (side * camera_side <= settings.tracking.plane_distance ||
             std::abs(plane->head<3>().dot(hider) + (*plane)(3)) <= settings.tracking.plane_distance) {
