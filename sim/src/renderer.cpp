@@ -143,6 +143,39 @@ struct Renderer::Impl {
     return points;
   }
 
+  // The same samples in ray_order: neighbours on the surface next to each
+  // other, so that the rays of one packet of visible_fraction() run close
+  // together through the scene.
+  [[nodiscard]] std::vector<WorldPoint> object_points_in_ray_order() const {
+    const TriangleMesh& m = world[static_cast<std::size_t>(object)];
+    const auto& all = samples[static_cast<std::size_t>(object)];
+    std::vector<WorldPoint> points;
+    points.reserve(ray_order.size());
+    for (const int k : ray_order) points.push_back(at(m, all[static_cast<std::size_t>(k)]));
+    return points;
+  }
+  std::vector<int> ray_order;  // the object's samples in Morton order of their place at time 0
+
+  void order_rays() {
+    const std::vector<WorldPoint> points = object_points();
+    Eigen::AlignedBox3d box;
+    for (const WorldPoint& w : points) box.extend(w.p);
+    const Eigen::Vector3d size = box.sizes().cwiseMax(1e-9);
+    std::vector<std::pair<std::uint64_t, int>> keyed;
+    keyed.reserve(points.size());
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const Eigen::Vector3d q = ((points[k].p - box.min()).cwiseQuotient(size) * 1023.0).cwiseMax(0.0).cwiseMin(1023.0);
+      std::uint64_t key = 0;
+      for (int bit = 9; bit >= 0; --bit) {
+        for (int a = 0; a < 3; ++a) key = (key << 1) | ((static_cast<std::uint64_t>(q[a]) >> bit) & 1u);
+      }
+      keyed.emplace_back(key, static_cast<int>(k));
+    }
+    std::sort(keyed.begin(), keyed.end());
+    ray_order.clear();
+    for (const auto& [key, k] : keyed) ray_order.push_back(k);
+  }
+
   // The fraction of the samples facing a camera at wMc that it sees: in its
   // image, within its depth range and with nothing in between.
   [[nodiscard]] double visible_fraction(const std::vector<WorldPoint>& points, const Eigen::Isometry3d& wMc,
@@ -151,10 +184,10 @@ struct Renderer::Impl {
     const Eigen::Isometry3d cMw = wMc.inverse();
     const CameraIntrinsics& k = sensor.intrinsics;
     int facing = 0, seen = 0;
-    // Rays from the camera to the samples it may see, 8 to a packet.
-    constexpr int kPacket = 8;
-    alignas(32) int valid[kPacket];
-    RTCRay8 ray{};  // lanes past the last sample stay zero (and invalid)
+    // Rays from the camera to the samples it may see, 16 to a packet.
+    constexpr int kPacket = 16;
+    alignas(64) int valid[kPacket];
+    RTCRay16 ray{};  // lanes past the last sample stay zero (and invalid)
     for (int j = 0; j < kPacket; ++j) {
       ray.org_x[j] = static_cast<float>(o.x());
       ray.org_y[j] = static_cast<float>(o.y());
@@ -169,7 +202,7 @@ struct Renderer::Impl {
       RTCIntersectContext context;
       rtcInitIntersectContext(&context);
       context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-      rtcOccluded8(valid, scene, &context, &ray);
+      rtcOccluded16(valid, scene, &context, &ray);
       for (int j = 0; j < filled; ++j) seen += ray.tfar[j] < 0.0f ? 0 : 1;
       filled = 0;
     };
@@ -214,6 +247,7 @@ Renderer::Renderer(const Scenario& scenario, int surface_samples)
     impl_->samples.push_back(sample_surface(b.mesh, n, 7919u * static_cast<unsigned>(k + 1)));
   }
   set_time(0.0);
+  impl_->order_rays();
 }
 
 Renderer::~Renderer() = default;
@@ -223,7 +257,7 @@ void Renderer::set_time(double t) {
   time_ = t;
   if (impl_->scene != nullptr) rtcReleaseScene(impl_->scene);
   impl_->scene = rtcNewScene(impl_->device);
-  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_LOW);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_MEDIUM);
   impl_->world.clear();
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
     impl_->world.push_back(scenario_.bodies[k].world_mesh(t));
@@ -416,7 +450,7 @@ void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing,
 ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {
   ObjectTruth t;
   t.centroid = object_centroid();
-  t.visible_fraction = impl_->visible_fraction(impl_->object_points(), wMc, scenario_.sensor);
+  t.visible_fraction = impl_->visible_fraction(impl_->object_points_in_ray_order(), wMc, scenario_.sensor);
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     if (scenario_.bodies[b].role != Role::Occluder) continue;
     const auto& verts = impl_->world[b].vertices;
@@ -447,7 +481,7 @@ std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometr
   for (const Eigen::Isometry3d& wMc : poses) {
     if (!wMc.matrix().allFinite()) throw std::invalid_argument("renderer: a camera pose is not finite");
   }
-  const std::vector<WorldPoint> points = impl_->object_points();
+  const std::vector<WorldPoint> points = impl_->object_points_in_ray_order();
   std::vector<double> fractions(poses.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses.size()), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
