@@ -143,16 +143,27 @@ struct Renderer::Impl {
     return points;
   }
 
-  // The same samples in ray_order: neighbours on the surface next to each
-  // other, so that the rays of one packet of visible_fraction() run close
-  // together through the scene.
-  [[nodiscard]] std::vector<WorldPoint> object_points_in_ray_order() const {
+  // The object's surface samples in ray_order (neighbours on the surface
+  // next to each other, so that the rays of one packet of visible_fraction()
+  // run close together through the scene), and a ball that holds them.
+  struct Samples {
+    std::vector<WorldPoint> points;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    double radius = 0.0;
+  };
+  [[nodiscard]] Samples object_samples() const {
     const TriangleMesh& m = world[static_cast<std::size_t>(object)];
     const auto& all = samples[static_cast<std::size_t>(object)];
-    std::vector<WorldPoint> points;
-    points.reserve(ray_order.size());
-    for (const int k : ray_order) points.push_back(at(m, all[static_cast<std::size_t>(k)]));
-    return points;
+    Samples out;
+    out.points.reserve(ray_order.size());
+    Eigen::AlignedBox3d box;
+    for (const int k : ray_order) {
+      out.points.push_back(at(m, all[static_cast<std::size_t>(k)]));
+      box.extend(out.points.back().p);
+    }
+    out.centre = box.center();
+    for (const WorldPoint& w : out.points) out.radius = std::max(out.radius, (w.p - out.centre).norm());
+    return out;
   }
   std::vector<int> ray_order;  // the object's samples in Morton order of their place at time 0
 
@@ -178,11 +189,21 @@ struct Renderer::Impl {
 
   // The fraction of the samples facing a camera at wMc that it sees: in its
   // image, within its depth range and with nothing in between.
-  [[nodiscard]] double visible_fraction(const std::vector<WorldPoint>& points, const Eigen::Isometry3d& wMc,
+  [[nodiscard]] double visible_fraction(const Samples& target, const Eigen::Isometry3d& wMc,
                                         const SensorSettings& sensor) const {
     const Eigen::Vector3d o = wMc.translation();
     const Eigen::Isometry3d cMw = wMc.inverse();
     const CameraIntrinsics& k = sensor.intrinsics;
+    // When the samples' ball lies in the image and the depth range (by far
+    // more than rounding), so does every sample: no need to project each.
+    const Eigen::Vector3d b = cMw * target.centre;
+    const double r = target.radius + 1e-6;
+    const auto clear_of = [&](double f, double c, double side, double along, double depth) {
+      return f * along + c * depth >= r * std::hypot(f, c) && side * depth - f * along >= r * std::hypot(f, side);
+    };
+    const bool all_in_view = b.z() - r >= sensor.min_depth && b.z() + r <= sensor.max_depth &&
+                             clear_of(k.fx, k.cx, k.width - 1.0 - k.cx, b.x(), b.z()) &&
+                             clear_of(k.fy, k.cy, k.height - 1.0 - k.cy, b.y(), b.z());
     int facing = 0, seen = 0;
     // Rays from the camera to the samples it may see, 16 to a packet.
     constexpr int kPacket = 16;
@@ -206,13 +227,15 @@ struct Renderer::Impl {
       for (int j = 0; j < filled; ++j) seen += ray.tfar[j] < 0.0f ? 0 : 1;
       filled = 0;
     };
-    for (const WorldPoint& w : points) {
+    for (const WorldPoint& w : target.points) {
       if (w.n.dot(o - w.p) <= 0.0) continue;
       ++facing;
-      const Eigen::Vector3d pc = cMw * w.p;
-      if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth) continue;
-      const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
-      if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
+      if (!all_in_view) {
+        const Eigen::Vector3d pc = cMw * w.p;
+        if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth) continue;
+        const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
+        if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
+      }
       const Eigen::Vector3d d = w.p - o;
       valid[filled] = -1;
       ray.dir_x[filled] = static_cast<float>(d.x());
@@ -450,7 +473,7 @@ void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing,
 ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {
   ObjectTruth t;
   t.centroid = object_centroid();
-  t.visible_fraction = impl_->visible_fraction(impl_->object_points_in_ray_order(), wMc, scenario_.sensor);
+  t.visible_fraction = impl_->visible_fraction(impl_->object_samples(), wMc, scenario_.sensor);
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     if (scenario_.bodies[b].role != Role::Occluder) continue;
     const auto& verts = impl_->world[b].vertices;
@@ -481,11 +504,11 @@ std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometr
   for (const Eigen::Isometry3d& wMc : poses) {
     if (!wMc.matrix().allFinite()) throw std::invalid_argument("renderer: a camera pose is not finite");
   }
-  const std::vector<WorldPoint> points = impl_->object_points_in_ray_order();
+  const Impl::Samples samples = impl_->object_samples();
   std::vector<double> fractions(poses.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses.size()), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      fractions[i] = impl_->visible_fraction(points, poses[i], scenario_.sensor);
+      fractions[i] = impl_->visible_fraction(samples, poses[i], scenario_.sensor);
     }
   });
   return fractions;

@@ -306,6 +306,16 @@ TEST(Truth, VisibleFractionOnHandComputedCases) {
     Renderer r(wall_scene(-0.6));
     EXPECT_EQ(r.truth(r.scenario().wMc_start, r_sphere).visible_fraction, 0.0);
   }
+  {  // half outside the image: the camera 0.312 m to the side puts the image's left border (fx 307.5,
+     // cx 160) at x = 0 on the wall; the front face's right half and the side face towards the
+     // camera (0.2 x 0.01) are seen, of the front and that side: 0.022 / 0.042
+    Renderer r(wall_scene(0.6));
+    Eigen::Isometry3d wMc = r.scenario().wMc_start;
+    wMc.translation().x() = 0.6 * 160.0 / 307.5;
+    EXPECT_NEAR(r.truth(wMc, r_sphere).visible_fraction, 0.022 / 0.042, 0.03);
+    wMc.translation().x() = 1.0;  // the wall out of the image altogether
+    EXPECT_EQ(r.truth(wMc, r_sphere).visible_fraction, 0.0);
+  }
 }
 
 // In front of the wall, beside the field of view, behind the wall, behind the camera.
