@@ -128,6 +128,7 @@ struct Renderer::Impl {
   std::vector<double> dropout;                   // per label: Body::dropout
   std::vector<std::vector<SurfaceSample>> samples;  // per body
   int object = 0;
+  std::vector<int> ray_order;  // the object's samples, neighbours on its surface next to each other (order_rays())
 
   ~Impl() {
     if (scene != nullptr) rtcReleaseScene(scene);
@@ -165,8 +166,7 @@ struct Renderer::Impl {
     for (const WorldPoint& w : out.points) out.radius = std::max(out.radius, (w.p - out.centre).norm());
     return out;
   }
-  std::vector<int> ray_order;  // the object's samples in Morton order of their place at time 0
-
+  // Sets ray_order: the object's samples in Morton order of their place at time 0.
   void order_rays() {
     const std::vector<WorldPoint> points = object_points();
     Eigen::AlignedBox3d box;
@@ -280,6 +280,8 @@ void Renderer::set_time(double t) {
   time_ = t;
   if (impl_->scene != nullptr) rtcReleaseScene(impl_->scene);
   impl_->scene = rtcNewScene(impl_->device);
+  // Medium: builds about as fast as low for these few thousand triangles,
+  // and traces faster (the planner casts millions of rays into one scene).
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_MEDIUM);
   impl_->world.clear();
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
