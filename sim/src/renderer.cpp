@@ -118,6 +118,43 @@ void grid_cells(const std::vector<WorldPoint>& pts, double cell, Eigen::Matrix3X
   }
 }
 
+// Whether every vertex lies on the inner side of every triangle's plane
+// (within a micrometre). Then the mesh lies in the half-space behind each of
+// its triangles, so a segment from a point in front of a triangle to a point
+// of it meets the mesh nowhere else.
+bool convex(const TriangleMesh& m) {
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d a = m.vertices[t[0]].cast<double>();
+    const Eigen::Vector3d n = (m.vertices[t[1]].cast<double>() - a).cross(m.vertices[t[2]].cast<double>() - a);
+    const double area = n.norm();
+    if (!(area > 0.0)) continue;
+    for (const Eigen::Vector3f& v : m.vertices) {
+      if (n.dot(v.cast<double>() - a) > 1e-6 * area) return false;
+    }
+  }
+  return true;
+}
+
+// Whether a convex mesh is the surface of its bounding box: its vertices
+// on all eight corners and none elsewhere, its area the box's.
+bool is_its_box(const TriangleMesh& m, const Eigen::AlignedBox3d& box) {
+  unsigned corners = 0;
+  for (const Eigen::Vector3f& p : m.vertices) {
+    unsigned corner = 0;
+    for (int j = 0; j < 3; ++j) {
+      if (p[j] == static_cast<float>(box.max()[j])) {
+        corner |= 1u << j;
+      } else if (p[j] != static_cast<float>(box.min()[j])) {
+        return false;
+      }
+    }
+    corners |= 1u << corner;
+  }
+  const Eigen::Vector3d size = box.sizes();
+  const double area = 2.0 * (size.x() * size.y() + size.y() * size.z() + size.z() * size.x());
+  return corners == 0xFFu && std::abs(m.area() - area) <= 1e-6 * area;
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -128,6 +165,9 @@ struct Renderer::Impl {
   std::vector<double> dropout;                   // per label: Body::dropout
   std::vector<std::vector<SurfaceSample>> samples;  // per body
   int object = 0;
+  std::vector<char> rigid_convex;             // per body (a convex object hides none of its facing samples)
+  std::vector<Eigen::AlignedBox3d> boxes;     // per body, at the current time
+  std::vector<char> solid_box;                // per body: convex, its vertices its box's corners (set_time())
   std::vector<int> ray_order;  // the object's samples, neighbours on its surface next to each other (order_rays())
 
   ~Impl() {
@@ -187,8 +227,76 @@ struct Renderer::Impl {
     for (const auto& [key, k] : keyed) ray_order.push_back(k);
   }
 
+  // Whether a body other than the object may lie on a segment from o to the
+  // object's samples: unless a plane of its box has o strictly on one side and
+  // the object's box on the other, or its box's ball misses the cone from o
+  // around the samples' ball (or lies beyond their far side).
+  [[nodiscard]] bool others_in_the_way(const Samples& target, const Eigen::Vector3d& o) const {
+    const Eigen::AlignedBox3d& object_box = boxes[static_cast<std::size_t>(object)];
+    const Eigen::Vector3d axis = target.centre - o;
+    const double l = axis.norm();
+    if (l <= target.radius) return true;
+    const double half_angle = std::asin(target.radius / l);
+    for (std::size_t b = 0; b < boxes.size(); ++b) {
+      if (static_cast<int>(b) == object) continue;
+      const Eigen::AlignedBox3d& box = boxes[b];
+      bool apart = false;
+      for (int k = 0; k < 3 && !apart; ++k) {
+        // The camera strictly on its side of the plane, the object on or behind it.
+        apart = (o[k] < box.min()[k] && object_box.max()[k] <= box.min()[k]) ||
+                (o[k] > box.max()[k] && object_box.min()[k] >= box.max()[k]);
+      }
+      if (apart) continue;
+      const Eigen::Vector3d to = box.center() - o;
+      const double radius = 0.5 * box.diagonal().norm(), dist = to.norm();
+      if (dist <= radius) return true;
+      if (dist - radius > l + target.radius) continue;
+      const double angle = std::acos(std::clamp(to.dot(axis) / (dist * l), -1.0, 1.0));
+      if (angle <= half_angle + std::asin(radius / dist)) return true;
+    }
+    return false;
+  }
+
+  // Whether every segment from o to the object passes through a body that is
+  // its own bounding box: o beyond the box's face on one axis, the object's
+  // box before its opposite face, and the segments from o to the object's box
+  // corners crossing the near face's plane inside that face (with a margin far
+  // above rounding). The object's box holds its samples, and the crossings of
+  // the segments to them lie in the hull of the corners' crossings.
+  [[nodiscard]] bool behind_a_box(const Eigen::Vector3d& o) const {
+    constexpr double kMargin = 1e-6;  // [m]
+    const Eigen::AlignedBox3d& object_box = boxes[static_cast<std::size_t>(object)];
+    for (std::size_t b = 0; b < boxes.size(); ++b) {
+      if (!solid_box[b] || static_cast<int>(b) == object) continue;
+      const Eigen::AlignedBox3d& box = boxes[b];
+      for (int k = 0; k < 3; ++k) {
+        double face = 0.0;
+        if (o[k] > box.max()[k] && object_box.max()[k] < box.min()[k] - kMargin) {
+          face = box.max()[k];
+        } else if (o[k] < box.min()[k] && object_box.min()[k] > box.max()[k] + kMargin) {
+          face = box.min()[k];
+        } else {
+          continue;
+        }
+        bool inside = true;
+        for (int corner = 0; corner < 8 && inside; ++corner) {
+          const Eigen::Vector3d c = object_box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+          const Eigen::Vector3d q = o + (face - o[k]) / (c[k] - o[k]) * (c - o);
+          for (int j = 0; j < 3; ++j) {
+            if (j != k && (q[j] < box.min()[j] + kMargin || q[j] > box.max()[j] - kMargin)) inside = false;
+          }
+        }
+        if (inside) return true;
+      }
+    }
+    return false;
+  }
+
   // The fraction of the samples facing a camera at wMc that it sees: in its
-  // image, within its depth range and with nothing in between.
+  // image, within its depth range and with nothing in between. No ray is
+  // cast where the answer is known: a body that is its own box across every
+  // line of sight (none seen), or a convex object with no other body in the
+  // way (every facing sample in view seen).
   [[nodiscard]] double visible_fraction(const Samples& target, const Eigen::Isometry3d& wMc,
                                         const SensorSettings& sensor) const {
     const Eigen::Vector3d o = wMc.translation();
@@ -204,6 +312,13 @@ struct Renderer::Impl {
     const bool all_in_view = b.z() - r >= sensor.min_depth && b.z() + r <= sensor.max_depth &&
                              clear_of(k.fx, k.cx, k.width - 1.0 - k.cx, b.x(), b.z()) &&
                              clear_of(k.fy, k.cy, k.height - 1.0 - k.cy, b.y(), b.z());
+    if (behind_a_box(o)) return 0.0;
+    const bool cast = rigid_convex[static_cast<std::size_t>(object)] == 0 || others_in_the_way(target, o);
+    if (!cast && all_in_view) {  // every facing sample is seen
+      const bool any = std::any_of(target.points.begin(), target.points.end(),
+                                   [&](const WorldPoint& w) { return w.n.dot(o - w.p) > 0.0; });
+      return any ? 1.0 : 0.0;
+    }
     int facing = 0, seen = 0;
     // Rays from the camera to the samples it may see, 16 to a packet.
     constexpr int kPacket = 16;
@@ -236,6 +351,10 @@ struct Renderer::Impl {
         const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
         if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
       }
+      if (!cast) {
+        ++seen;
+        continue;
+      }
       const Eigen::Vector3d d = w.p - o;
       valid[filled] = -1;
       ray.dir_x[filled] = static_cast<float>(d.x());
@@ -265,6 +384,7 @@ Renderer::Renderer(const Scenario& scenario, int surface_samples)
     if (impl_->dropout.size() <= impl_->labels.back()) impl_->dropout.resize(impl_->labels.back() + 1u, 0.0);
     impl_->dropout[impl_->labels.back()] = std::max(impl_->dropout[impl_->labels.back()], b.dropout);
     if (b.role == Role::Object) impl_->object = static_cast<int>(k);
+    impl_->rigid_convex.push_back(!b.deformable() && convex(b.mesh) ? 1 : 0);
     const int n = b.role == Role::Object ? surface_samples
                                          : std::clamp(static_cast<int>(b.mesh.area() / (0.004 * 0.004)), 200, 20000);
     impl_->samples.push_back(sample_surface(b.mesh, n, 7919u * static_cast<unsigned>(k + 1)));
@@ -284,9 +404,14 @@ void Renderer::set_time(double t) {
   // and traces faster (the planner casts millions of rays into one scene).
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_MEDIUM);
   impl_->world.clear();
+  impl_->boxes.clear();
+  impl_->solid_box.clear();
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
     impl_->world.push_back(scenario_.bodies[k].world_mesh(t));
     const TriangleMesh& m = impl_->world.back();
+    Eigen::AlignedBox3d& box = impl_->boxes.emplace_back();
+    for (const Eigen::Vector3f& p : m.vertices) box.extend(p.cast<double>());
+    impl_->solid_box.push_back(impl_->rigid_convex[k] != 0 && is_its_box(m, box) ? 1 : 0);
     RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), m.vertices.size()));

@@ -318,6 +318,65 @@ TEST(Truth, VisibleFractionOnHandComputedCases) {
   }
 }
 
+// Cameras on a sphere of radius r around c looking at c (y of the image as
+// near world y as the view allows), in a Fibonacci spiral.
+std::vector<Eigen::Isometry3d> views_around(const Eigen::Vector3d& c, double r, int n) {
+  std::vector<Eigen::Isometry3d> views;
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n, ring = std::sqrt(1.0 - z * z), phi = 2.399963229728653 * i;
+    const Eigen::Vector3d o = c + r * Eigen::Vector3d(ring * std::cos(phi), z, ring * std::sin(phi));
+    const Eigen::Vector3d look = (c - o).normalized();
+    const Eigen::Vector3d side = Eigen::Vector3d::UnitY().cross(look);
+    Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+    if (side.norm() < 1e-6) continue;
+    const Eigen::Vector3d x = side.normalized(), y = look.cross(x);
+    wMc.linear() << x, y, look;
+    wMc.translation() = o;
+    views.push_back(wMc);
+  }
+  return views;
+}
+
+TEST(Truth, VisibleFractionIsTheSameWhereNoShortcutApplies) {
+  // No ray is cast where the answer is known: a convex object with no other
+  // body between it and the camera (every facing sample seen), or a body
+  // that is its own box across every line of sight (none seen). Turning the
+  // world makes the table no longer its box's, and a small ball inside the
+  // object puts a body in every view's cone: there every ray is cast.
+  const std::string bodies =
+      "object: {shape: box, size: [0.19, 0.135, 0.015], position: [0, 0, 0.5], rpy_deg: [0, 20, 0]}\n"
+      "table: {position: [0, 0.09, 0.6], size: [1.2, 0.02, 1.0]}\n";
+  const std::string hand = "{shape: capsule, radius: 0.03, length: 0.1, rpy_deg: [0, 90, 0], position: [0.05, -0.02, 0.3]}";
+  const Scenario straight = scenario_from_yaml("sensor: {noise: {enabled: false}}\n" + bodies + "occluders: [" + hand + "]\n",
+                                               kSource);
+  Scenario turned = scenario_from_yaml("sensor: {noise: {enabled: false}}\n" + bodies + "occluders: [" + hand +
+                                           ", {shape: sphere, radius: 0.004, position: [0, 0, 0.5]}]\n",
+                                       kSource);
+  const Eigen::Isometry3d R(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()));
+  for (Body& b : turned.bodies) {
+    for (Waypoint& w : b.motion.waypoints) {
+      const Eigen::Matrix3d m = R.linear() * rpy_deg_to_matrix(w.rpy_deg);
+      w.position = R * w.position;
+      w.rpy_deg = Eigen::Vector3d(std::atan2(m(2, 1), m(2, 2)), std::asin(-m(2, 0)), std::atan2(m(1, 0), m(0, 0))) * 180.0 / kPi;
+    }
+  }
+  const Renderer a(straight), b(turned);
+  const std::vector<Eigen::Isometry3d> views = views_around({0, 0, 0.5}, 0.5, 400);
+  std::vector<Eigen::Isometry3d> turned_views;
+  for (const Eigen::Isometry3d& v : views) turned_views.push_back(R * v);
+  const std::vector<double> fa = a.visible_fractions(views), fb = b.visible_fractions(turned_views);
+  int none = 0, all = 0, part = 0;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    EXPECT_NEAR(fa[i], fb[i], 2e-3) << "view " << i << " at " << views[i].translation().transpose();
+    none += fa[i] == 0.0 ? 1 : 0;
+    all += fa[i] == 1.0 ? 1 : 0;
+    part += fa[i] > 0.0 && fa[i] < 1.0 ? 1 : 0;
+  }
+  EXPECT_GT(none, 100);  // under the table
+  EXPECT_GT(all, 100);
+  EXPECT_GT(part, 10);   // behind the hand, across the table's edge
+}
+
 // In front of the wall, beside the field of view, behind the wall, behind the camera.
 Scenario four_occluders() {
   return wall_scene(0.6,
