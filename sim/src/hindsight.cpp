@@ -27,6 +27,7 @@ constexpr double kUnreached = -std::numeric_limits<double>::infinity();
 constexpr int kMaxViews = 100000;
 constexpr double kPiece = 0.04;     // size of the pieces of a moving body tested against a view's cone [m]
 constexpr double kOnSphere = 1e-3;  // a camera this close to its sphere is on it [m]
+constexpr int kDirectSteps = 8;     // straight moves from the start: up to this many steps longer than the approach
 
 // The camera at `position` looking at `centroid`, turned from `start` by the least rotation.
 Eigen::Isometry3d looking_at(const Eigen::Vector3d& position, const Eigen::Vector3d& centroid,
@@ -299,19 +300,27 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
 
   // The centroid's largest move in one step is at most the largest move of
   // one of the object's vertices (the centroid is a mean of surface points).
+  // The object's centroid at every step.
   const Body& target = scenario.bodies.front();
   double max_shift = 0.0;
+  Renderer renderer(scenario);  // at time 0
+  std::vector<Eigen::Vector3d> c(static_cast<std::size_t>(steps), renderer.object_centroid());
   TriangleMesh before = target.world_mesh(0.0);
   for (long i = 0; i < steps; ++i) {
+    const auto si = static_cast<std::size_t>(i);
     plan.times.push_back(static_cast<double>(i * settings.frames_per_step) * frame);
     TriangleMesh now = target.world_mesh(plan.times.back());
     for (std::size_t k = 0; k < now.vertices.size(); ++k) {
       max_shift = std::max(max_shift, static_cast<double>((now.vertices[k] - before.vertices[k]).norm()));
     }
+    if (i > 0 && now.vertices != before.vertices) {
+      renderer.set_time(plan.times.back());
+      c[si] = renderer.object_centroid();
+    } else if (i > 0) {
+      c[si] = c[si - 1];
+    }
     before = std::move(now);
   }
-  Renderer renderer(scenario);  // at time 0
-  std::vector<Eigen::Vector3d> c(static_cast<std::size_t>(steps), renderer.object_centroid());
 
   const int n = std::max(1, static_cast<int>(std::lround(4.0 * kPi * r_sphere * r_sphere / (settings.spacing * settings.spacing))));
   plan.lattice_views = n;
@@ -346,6 +355,29 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   auto position = [&](std::size_t s, long i) -> Eigen::Vector3d {
     return s < static_cast<std::size_t>(n) ? Eigen::Vector3d(c[static_cast<std::size_t>(i)] + r_sphere * d.col(static_cast<Eigen::Index>(s)))
                                            : a[s - static_cast<std::size_t>(n)];
+  };
+  // A camera off its sphere need not reach it along the radius first:
+  // straight moves from the start to a lattice view at constant speed, in
+  // the fewest steps k (up to the approach's plus kDirectSteps) that reach
+  // it. The steps in between are off the sphere, scored where the camera
+  // is; `sum` gathers their values.
+  struct Direct {
+    int view = 0, k = 0;
+    double sum = 0.0;
+  };
+  std::vector<Direct> direct;
+  std::vector<int> direct_to(static_cast<std::size_t>(n), -1);
+  for (int v = 0; v < n && chain > 0; ++v) {
+    for (long k = 1; k <= std::min<long>({chain + kDirectSteps, 255, steps - 1}); ++k) {
+      if ((position(static_cast<std::size_t>(v), k) - start).norm() <= static_cast<double>(k) * reach) {
+        direct_to[static_cast<std::size_t>(v)] = static_cast<int>(direct.size());
+        direct.push_back({v, static_cast<int>(k)});
+        break;
+      }
+    }
+  }
+  auto on_the_way = [&](const Direct& g, long i) -> Eigen::Vector3d {
+    return start + (position(static_cast<std::size_t>(g.view), g.k) - start) * (static_cast<double>(i) / g.k);
   };
   // The camera at o at step i, turned from its start towards the centroid by
   // at most max_turn_rate x the time (at time 0: as the scenario places it);
@@ -385,12 +417,6 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
         pieces[b].clear();
       }
       meshes[b] = std::move(m);
-    }
-    if (changes.object) {
-      renderer.set_time(plan.times[si]);
-      c[si] = renderer.object_centroid();
-    } else if (i > 0) {
-      c[si] = c[si - 1];
     }
     // Every lattice view looking at the centroid (the unlimited bound needs
     // them all) that may have changed since the last step.
@@ -446,6 +472,20 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       for (std::size_t k = 0; k < seen.size(); ++k) value[si][static_cast<std::size_t>(evaluate[k])] = seen[k];
     }
 
+    poses.clear();
+    std::vector<std::size_t> moving;
+    for (std::size_t g = 0; g < direct.size() && i > 0; ++g) {
+      if (direct[g].k <= i) continue;
+      bool turned = false;
+      moving.push_back(g);
+      poses.push_back(aimed(on_the_way(direct[g], i), i, &turned));
+    }
+    if (!poses.empty()) {
+      const std::vector<double> seen = renderer.visible_fractions(poses);
+      plan.evaluations += static_cast<long>(seen.size());
+      for (std::size_t k = 0; k < seen.size(); ++k) direct[moving[k]].sum += seen[k];
+    }
+
     if (i == 0) {
       total_at(0)[static_cast<std::size_t>(n)] = value[si][static_cast<std::size_t>(n)];
       continue;
@@ -478,6 +518,14 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       if (total[end] > best && (here - a[static_cast<std::size_t>(chain)]).norm() <= reach) {
         best = total[end];
         arg = static_cast<int>(end);
+      }
+      if (const int g = direct_to[sv]; g >= 0 && direct[static_cast<std::size_t>(g)].k == i) {
+        const double t = value[0][static_cast<std::size_t>(n)] + direct[static_cast<std::size_t>(g)].sum;
+        if (t > best) {
+          best = t;
+          arg = n;
+          steps_of_move = static_cast<std::uint8_t>(i);
+        }
       }
       if (before_move != nullptr) {
         for (std::size_t g = segments.first[sv]; g < segments.first[sv + 1]; ++g) {
@@ -535,8 +583,11 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     const auto u = static_cast<std::size_t>(from[si][last]);
     for (int m = 1; m < k; ++m) {
       const auto sj = si - static_cast<std::size_t>(k - m);
-      plan.views[sj] = c[sj] + r_sphere * between(d.col(static_cast<Eigen::Index>(u)),
-                                                  d.col(static_cast<Eigen::Index>(last)), static_cast<double>(m) / k);
+      const double f = static_cast<double>(m) / k;
+      plan.views[sj] = u == static_cast<std::size_t>(n)
+                           ? Eigen::Vector3d(start + (plan.views[si] - start) * f)  // from the start, straight
+                           : Eigen::Vector3d(c[sj] + r_sphere * between(d.col(static_cast<Eigen::Index>(u)),
+                                                                        d.col(static_cast<Eigen::Index>(last)), f));
       inside.push_back(sj);
     }
     last = u;

@@ -66,6 +66,33 @@ TEST(Hindsight, AWallWithOneGapIsLeftAsFastAsTheLatticeAllows) {
   EXPECT_LE(plan_hindsight(s, s.wMc_start, 0.5, s.duration, one_step).bound, coarser - 2.0 / 31.0 + 1e-9);
 }
 
+// Started 3 cm inside its sphere, the camera heads for the gap at once,
+// reaching the sphere on the way, rather than along the radius first (two
+// steps of 1.67 cm); each step within the speed limit, and on the sphere
+// once it got there.
+TEST(Hindsight, ACameraOffItsSphereHeadsForTheGapAtOnce) {
+  Scenario s = wall_with_a_gap(1.0);
+  s.wMc_start.translation().z() = 0.03;
+  const HindsightPlan p = plan_hindsight(s, s.wMc_start, 0.5, s.duration, HindsightSettings{});
+  const HindsightPlan on_sphere = plan_hindsight(wall_with_a_gap(1.0), wall_with_a_gap(1.0).wMc_start, 0.5, 1.0,
+                                                 HindsightSettings{});
+  EXPECT_GT(p.views[1].x(), 0.005);
+  bool arrived = false;
+  for (std::size_t i = 1; i < p.views.size(); ++i) {
+    EXPECT_LE(step_length(p, i), 0.5 * p.step + 1e-9) << "step " << i;
+    EXPECT_GT(p.views[i].x(), p.views[i - 1].x() - 1e-9) << "step " << i;
+    const double off = std::abs((p.views[i] - p.centroids[i]).norm() - 0.5);
+    if (arrived) {
+      EXPECT_LT(off, 1e-9) << "step " << i;
+    }
+    arrived = arrived || off < 1e-9;
+  }
+  EXPECT_TRUE(arrived);
+  // 3 cm nearer the wall, its edge is 1.5 cm nearer in x: the camera sees
+  // the target no later than from the sphere.
+  EXPECT_GE(p.bound, on_sphere.bound);
+}
+
 TEST(Hindsight, NothingInTheWayKeepsTheCameraWhereItIs) {
   const Scenario s = scenario_from_yaml(
       "duration: 0.5\nsensor: {noise: {enabled: false}}\ncamera: {position: [0, 0, 0], look_at: [0, 0, 0.5]}\n"

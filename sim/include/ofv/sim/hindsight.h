@@ -26,8 +26,10 @@
  * heuristic search. The camera starts where and as the scenario puts it and
  * turns towards the centroid at up to `max_turn_rate` (a view it could reach
  * before it could have turned to look at the centroid is scored as turned
- * so far; the unlimited bound's views look at it); off its sphere, it first
- * reaches the sphere along the radius at full speed.
+ * so far; the unlimited bound's views look at it); off its sphere, it
+ * reaches the sphere along the radius at full speed, or goes straight to a
+ * lattice view in as few steps as its speed allows (up to 8 steps more than
+ * the radius takes), the steps on the way scored where it is.
  *
  * The cost is at most views x steps visibility evaluations (each ray casts
  * the object's surface samples that face the view) plus views x (neighbours
