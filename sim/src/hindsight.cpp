@@ -298,9 +298,9 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   const long steps = (frames - 1) / settings.frames_per_step + 1;
   const double reach = settings.max_speed * plan.step;
 
-  // The centroid's largest move in one step is at most the largest move of
-  // one of the object's vertices (the centroid is a mean of surface points).
-  // The object's centroid at every step.
+  // The object's centroid at every step, and a bound on its largest move in
+  // one step: the largest move of one of the object's vertices (the
+  // centroid is a mean of surface points).
   const Body& target = scenario.bodies.front();
   double max_shift = 0.0;
   Renderer renderer(scenario);  // at time 0
@@ -473,17 +473,17 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     }
 
     poses.clear();
-    std::vector<std::size_t> moving;
+    std::vector<std::size_t> under_way;  // the straight moves from the start not at their view yet
     for (std::size_t g = 0; g < direct.size() && i > 0; ++g) {
       if (direct[g].k <= i) continue;
       bool turned = false;
-      moving.push_back(g);
+      under_way.push_back(g);
       poses.push_back(aimed(on_the_way(direct[g], i), i, &turned));
     }
     if (!poses.empty()) {
       const std::vector<double> seen = renderer.visible_fractions(poses);
       plan.evaluations += static_cast<long>(seen.size());
-      for (std::size_t k = 0; k < seen.size(); ++k) direct[moving[k]].sum += seen[k];
+      for (std::size_t k = 0; k < seen.size(); ++k) direct[under_way[k]].sum += seen[k];
     }
 
     if (i == 0) {
