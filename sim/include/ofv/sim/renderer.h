@@ -37,7 +37,9 @@ struct RenderedFrame {
 /// \brief Ground truth of the object at one time and camera pose.
 struct ObjectTruth {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< area-weighted surface centroid [m]
-  double visible_fraction = 0.0;  ///< fraction of the surface the camera sees [0, 1]
+  /// Of the object's surface samples that face the camera, the fraction it sees:
+  /// in its image and depth range, with nothing in between [0, 1].
+  double visible_fraction = 0.0;
   int occluders_in_sphere = 0;    ///< occluders with a vertex within r_sphere of the centroid
 };
 
@@ -84,7 +86,11 @@ class Renderer {
   /**
    * \brief truth()'s visible fraction from each camera pose at the current
    *        time, the poses shared out among threads (oneTBB): what a planner
-   *        that scores many views of one instant asks for.
+   *        that scores many views of one instant asks for. Rays are cast
+   *        only where the answer is not known without them: none when a body
+   *        that is its own bounding box (a table) lies across every line of
+   *        sight, none when the object is rigid and convex and no other
+   *        body's box can lie on a line of sight (the same values).
    * \throws std::invalid_argument when a pose is not finite.
    */
   [[nodiscard]] std::vector<double> visible_fractions(const std::vector<Eigen::Isometry3d>& poses) const;
