@@ -5,6 +5,7 @@
 #include "ofv/settings_table.h"
 #include "ofv/sim/renderer.h"
 #include "ofv/view_methods.h"
+#include "sight_cone.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -225,19 +226,9 @@ struct Changes {
 // cone (or beyond the object) cannot change the view's visible fraction.
 bool may_change(const Changes& ch, const Eigen::Vector3d& o) {
   if (ch.object) return true;
-  const Ball& obj = ch.object_ball;
-  const Eigen::Vector3d axis = obj.centre - o;
-  const double l = axis.norm();
-  if (l <= obj.radius * 1.01) return true;
-  const double half_angle = std::asin(obj.radius / l);
-  return std::any_of(ch.balls.begin(), ch.balls.end(), [&](const Ball& b) {
-    const Eigen::Vector3d to = b.centre - o;
-    const double dist = to.norm();
-    if (dist <= b.radius) return true;
-    if (dist - b.radius > l + obj.radius) return false;
-    const double angle = std::acos(std::clamp(to.dot(axis) / (dist * l), -1.0, 1.0));
-    return angle <= half_angle + std::asin(b.radius / dist);
-  });
+  const detail::SightCone cone(o, ch.object_ball.centre, ch.object_ball.radius);
+  if (cone.length() <= ch.object_ball.radius * 1.01) return true;
+  return std::any_of(ch.balls.begin(), ch.balls.end(), [&](const Ball& b) { return cone.may_meet(b.centre, b.radius); });
 }
 
 }  // namespace

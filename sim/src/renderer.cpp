@@ -1,6 +1,7 @@
 // Embree ray casting of a scenario: RGB-D frames, labels and ground truth.
 #include "ofv/sim/renderer.h"
 #include "ofv/constants.h"
+#include "sight_cone.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -233,10 +234,8 @@ struct Renderer::Impl {
   // around the samples' ball (or lies beyond their far side).
   [[nodiscard]] bool others_in_the_way(const Samples& target, const Eigen::Vector3d& o) const {
     const Eigen::AlignedBox3d& object_box = boxes[static_cast<std::size_t>(object)];
-    const Eigen::Vector3d axis = target.centre - o;
-    const double l = axis.norm();
-    if (l <= target.radius) return true;
-    const double half_angle = std::asin(target.radius / l);
+    const detail::SightCone cone(o, target.centre, target.radius);
+    if (cone.length() <= target.radius) return true;
     for (std::size_t b = 0; b < boxes.size(); ++b) {
       if (static_cast<int>(b) == object) continue;
       const Eigen::AlignedBox3d& box = boxes[b];
@@ -246,13 +245,7 @@ struct Renderer::Impl {
         apart = (o[k] < box.min()[k] && object_box.max()[k] <= box.min()[k]) ||
                 (o[k] > box.max()[k] && object_box.min()[k] >= box.max()[k]);
       }
-      if (apart) continue;
-      const Eigen::Vector3d to = box.center() - o;
-      const double radius = 0.5 * box.diagonal().norm(), dist = to.norm();
-      if (dist <= radius) return true;
-      if (dist - radius > l + target.radius) continue;
-      const double angle = std::acos(std::clamp(to.dot(axis) / (dist * l), -1.0, 1.0));
-      if (angle <= half_angle + std::asin(radius / dist)) return true;
+      if (!apart && cone.may_meet(box.center(), 0.5 * box.diagonal().norm())) return true;
     }
     return false;
   }
