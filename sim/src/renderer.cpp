@@ -19,7 +19,6 @@
 #include <random>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 namespace ofv::sim {
 
@@ -154,6 +153,65 @@ bool is_its_box(const TriangleMesh& m, const Eigen::AlignedBox3d& box) {
   const Eigen::Vector3d size = box.sizes();
   const double area = 2.0 * (size.x() * size.y() + size.y() * size.z() + size.z() * size.x());
   return corners == 0xFFu && std::abs(m.area() - area) <= 1e-6 * area;
+}
+
+// Runs rows(row0, row1) over bands of 8 rows of an image `height` rows high,
+// in parallel (oneTBB, in the caller's task arena): a band has as much of
+// the scene or of the empty sky above it as its neighbours.
+void for_each_band(int height, const std::function<void(int, int)>& rows) {
+  constexpr int kBand = 8;
+  tbb::parallel_for(tbb::blocked_range<int>(0, (height + kBand - 1) / kBand), [&](const tbb::blocked_range<int>& r) {
+    for (int b = r.begin(); b != r.end(); ++b) rows(b * kBand, std::min((b + 1) * kBand, height));
+  });
+}
+
+// Depth as sensors and recordings store it, in 16-bit counts, so that a
+// recorded episode replays bit for bit.
+float quantised(float z) { return depth_from_units(depth_to_units(z, kTumDepthFactor), kTumDepthFactor); }
+
+void quantise_depth(RgbdFrame& f, int row0, int row1) {
+  const auto end = f.depth.begin() + static_cast<std::ptrdiff_t>(f.index(0, row1));
+  for (auto z = f.depth.begin() + static_cast<std::ptrdiff_t>(f.index(0, row0)); z != end; ++z) *z = quantised(*z);
+}
+
+// Depth noise and dropouts (NoiseModel) of rows [row0, row1), quantised:
+// `clean` is the depth before noise, `grazing` 1 where the ray meets the
+// surface more obliquely than the model's grazing angle, `dropout` the
+// drop-out probability of each label's own (dark or shiny) surface. A
+// generator per row, seeded from (seed, frame, row): the same frame whatever
+// the threads.
+void add_noise(RgbdFrame& f, int row0, int row1, const std::vector<std::uint8_t>& grazing,
+               const std::vector<float>& clean, const NoiseModel& m, std::uint64_t seed, long frame_index,
+               const std::vector<double>& dropout) {
+  const CameraIntrinsics& k = f.intrinsics;
+  for (int v = row0; v < row1; ++v) {
+    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull ^ (static_cast<std::uint64_t>(frame_index) << 20) ^
+                        static_cast<std::uint64_t>(v));
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    for (int u = 0; u < k.width; ++u) {
+      const std::size_t i = f.index(u, v);
+      const float z = clean[i];
+      if (z <= 0.0f) continue;
+      bool edge = false;
+      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || vv < 0 || uu >= k.width || vv >= k.height) continue;
+        const float zn = clean[f.index(uu, vv)];
+        edge = edge || zn <= 0.0f || std::abs(zn - z) > m.edge_jump;
+      }
+      const double noise_z = gauss(rng) * m.depth_sigma * z * z;
+      const double drop = uni(rng);
+      // A dark or shiny body's own drop-outs (drawn only for such a body,
+      // so the other scenarios' noise stays as it was).
+      const double dark = f.labels[i] < dropout.size() ? dropout[f.labels[i]] : 0.0;
+      if (grazing[i] != 0 || (edge && drop < m.edge_dropout) || (dark > 0.0 && uni(rng) < dark)) {
+        f.depth[i] = 0.0f;
+      } else {
+        f.depth[i] = quantised(static_cast<float>(z + noise_z));
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -471,7 +529,7 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
   for (int u = 0; u < k.width; ++u) column_term[static_cast<std::size_t>(u)] = R.col(0) * ((u - k.cx) / k.fx);
   const Eigen::Vector3d last = R.col(2);
   // Coherent rays of 8 neighbouring pixels are traced as one packet.
-  auto render_rows = [&](int row0, int row1) {
+  for_each_band(k.height, [&](int row0, int row1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -523,71 +581,17 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
         }
       }
     }
-  };
-  // Rows in parallel; noise needs the clean depth of the neighbour rows, so it
-  // is a second parallel pass.
-  const int threads = std::max(1, std::min<int>(static_cast<int>(std::thread::hardware_concurrency()), 8));
-  // Bands of kBand rows dealt out in turn, so that each thread gets as much
-  // of the scene as of the empty sky above it.
-  constexpr int kBand = 8;
-  auto in_parallel = [&](const std::function<void(int, int)>& rows) {
-    const auto bands_of = [&](int t) {
-      for (int row0 = t * kBand; row0 < k.height; row0 += threads * kBand) rows(row0, std::min(row0 + kBand, k.height));
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(bands_of, t);
-    bands_of(0);
-    for (auto& t : pool) t.join();
-  };
-  in_parallel(render_rows);
-  if (noise) add_noise(f, grazing, clean, sensor.noise, frame_index, in_parallel);
-  // Sensors and recordings store depth as 16-bit counts: so does the
-  // simulated sensor, so that a recorded episode replays bit for bit.
-  in_parallel([&](int row0, int row1) {
-    const auto end = f.depth.begin() + static_cast<std::ptrdiff_t>(f.index(0, row1));
-    for (auto z = f.depth.begin() + static_cast<std::ptrdiff_t>(f.index(0, row0)); z != end; ++z) {
-      *z = depth_from_units(depth_to_units(*z, kTumDepthFactor), kTumDepthFactor);
-    }
   });
-}
-
-void Renderer::add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing, std::vector<float>& clean,
-                         const NoiseModel& m, long frame_index, const ParallelRows& in_parallel) const {
-  const CameraIntrinsics& k = f.intrinsics;
-
-  // A generator per row, seeded from (scenario seed, frame, row): the same
-  // frame whatever the thread count.
-  clean = f.depth;
-  in_parallel([&](int row0, int row1) {
-    for (int v = row0; v < row1; ++v) {
-      std::mt19937_64 rng(scenario_.seed * 0x9E3779B97F4A7C15ull ^
-                          (static_cast<std::uint64_t>(frame_index) << 20) ^ static_cast<std::uint64_t>(v));
-      std::normal_distribution<double> gauss(0.0, 1.0);
-      std::uniform_real_distribution<double> uni(0.0, 1.0);
-      for (int u = 0; u < k.width; ++u) {
-        const std::size_t i = f.index(u, v);
-        const float z = clean[i];
-        if (z <= 0.0f) continue;
-        bool edge = false;
-        for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
-          const int uu = u + du, vv = v + dv;
-          if (uu < 0 || vv < 0 || uu >= k.width || vv >= k.height) continue;
-          const float zn = clean[f.index(uu, vv)];
-          edge = edge || zn <= 0.0f || std::abs(zn - z) > m.edge_jump;
-        }
-        const double noise_z = gauss(rng) * m.depth_sigma * z * z;
-        const double drop = uni(rng);
-        // A dark or shiny body's own drop-outs (drawn only for such a body,
-        // so the other scenarios' noise stays as it was).
-        const double dark = f.labels[i] < impl_->dropout.size() ? impl_->dropout[f.labels[i]] : 0.0;
-        if (grazing[i] != 0 || (edge && drop < m.edge_dropout) || (dark > 0.0 && uni(rng) < dark)) {
-          f.depth[i] = 0.0f;
-        } else {
-          f.depth[i] = static_cast<float>(z + noise_z);
-        }
-      }
-    }
-  });
+  // Noise needs the clean depth of the neighbour rows, so it is a second
+  // pass over the rows.
+  if (noise) {
+    clean = f.depth;
+    for_each_band(k.height, [&](int row0, int row1) {
+      add_noise(f, row0, row1, grazing, clean, sensor.noise, scenario_.seed, frame_index, impl_->dropout);
+    });
+  } else {
+    for_each_band(k.height, [&](int row0, int row1) { quantise_depth(f, row0, row1); });
+  }
 }
 
 ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const {

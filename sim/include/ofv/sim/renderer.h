@@ -14,7 +14,6 @@
 #include "ofv/sim/scenario.h"
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -116,13 +115,6 @@ class Renderer {
   [[nodiscard]] const Scenario& scenario() const { return scenario_; }
 
  private:
-  using ParallelRows = std::function<void(const std::function<void(int, int)>&)>;
-  // Depth noise and dropouts (NoiseModel), per row from (seed, frame, row);
-  // `grazing`: 1 where the ray meets the surface more obliquely than the
-  // model's grazing angle; `clean`: scratch for the depth before noise.
-  void add_noise(RgbdFrame& f, const std::vector<std::uint8_t>& grazing, std::vector<float>& clean,
-                 const NoiseModel& m, long frame_index, const ParallelRows& in_parallel) const;
-
   struct Impl;
   Scenario scenario_;
   double time_ = -1.0;
