@@ -15,8 +15,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <unordered_map>
 #include <random>
+#include <unordered_map>
 #include <stdexcept>
 #include <string>
 
@@ -653,21 +653,30 @@ int occluders_seen(const std::vector<std::uint16_t>& labels) {
   return count;
 }
 
-ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double r_seed,
-                                           double r_sphere, double obb_margin) const {
+ViewProblem Renderer::ground_truth_object(const Eigen::Isometry3d& wMc, double r_seed) const {
   const Eigen::Vector3d o = wMc.translation();
   const std::size_t obj = static_cast<std::size_t>(impl_->object);
-  // Object: camera-facing surface in r_seed cells; the OBB from all of it.
   std::vector<WorldPoint> facing;
-  Eigen::Matrix3Xd all(3, static_cast<Eigen::Index>(impl_->samples[obj].size()));
-  Eigen::Index n = 0;
+  facing.reserve(impl_->samples[obj].size());
   for (const auto& s : impl_->samples[obj]) {
     const WorldPoint w = at(impl_->world[obj], s);
-    all.col(n++) = w.p;
     if (w.n.dot(o - w.p) > 0.0) facing.push_back(w);
   }
   ViewProblem p;
   grid_cells(facing, r_seed, p.positions, &p.normals);
+  p.camera = o;
+  return p;
+}
+
+ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double r_seed,
+                                           double r_sphere, double obb_margin) const {
+  ViewProblem p = ground_truth_object(wMc, r_seed);
+  const Eigen::Vector3d o = wMc.translation();
+  // The augmented OBB from all of the object's surface.
+  const std::size_t obj = static_cast<std::size_t>(impl_->object);
+  Eigen::Matrix3Xd all(3, static_cast<Eigen::Index>(impl_->samples[obj].size()));
+  Eigen::Index n = 0;
+  for (const auto& s : impl_->samples[obj]) all.col(n++) = at(impl_->world[obj], s).p;
   const Eigen::Vector3d mean = all.rowwise().mean();
   const Eigen::Matrix3Xd centred = all.colwise() - mean;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred * centred.transpose());
@@ -689,7 +698,6 @@ ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double 
     }
   }
   grid_cells(occluding, r_seed, p.occluders, nullptr);
-  p.camera = o;
   return p;
 }
 

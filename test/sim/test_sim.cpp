@@ -422,6 +422,19 @@ TEST(Truth, GroundTruthProblemFacesTheCamera) {
   EXPECT_GT(e.iterations, 0);
 }
 
+TEST(Truth, GroundTruthObjectIsTheProblemWithoutItsOccluders) {
+  const Scenario s = load_scenario("dvd-one-hand");
+  Renderer r(s);
+  r.set_time(1.8);  // the hand in the sphere
+  const ViewProblem whole = r.ground_truth_problem(s.wMc_start, 0.02, 0.5);
+  const ViewProblem object = r.ground_truth_object(s.wMc_start, 0.02);
+  ASSERT_GT(whole.occluders.cols(), 0);
+  EXPECT_EQ(object.occluders.cols(), 0);
+  EXPECT_EQ(object.positions, whole.positions);
+  EXPECT_EQ(object.normals, whole.normals);
+  EXPECT_EQ(object.camera, whole.camera);
+}
+
 TEST(Renderer, NoiseIsDeterministicPerFrame) {
   const Scenario s = load_scenario("dvd-one-hand");
   Renderer r(s);

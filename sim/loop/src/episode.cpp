@@ -164,11 +164,14 @@ perception::ObjectSelection object_in(const std::vector<std::uint16_t>& labels) 
 
 // What the simulator knows of a frame, for the metrics: visibility, distance
 // to the sphere, the angular error of the camera against the ground-truth
-// supervoxels. Returns the ground-truth problem (the input in ground-truth mode).
-ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const EstimatorSettings& estimator) {
+// supervoxels. Returns the ground-truth problem, its occluders only when
+// asked for (the input in ground-truth mode; the metrics need the object's).
+ViewProblem record_truth(StepRecord& rec, const sim::Renderer& renderer, const EstimatorSettings& estimator,
+                         bool occluders) {
   const double r_sphere = estimator.r_sphere;
   const sim::ObjectTruth truth = renderer.truth(rec.wMc, r_sphere);
-  ViewProblem gt_problem = renderer.ground_truth_problem(rec.wMc, estimator.r_seed, r_sphere);
+  ViewProblem gt_problem = occluders ? renderer.ground_truth_problem(rec.wMc, estimator.r_seed, r_sphere)
+                                     : renderer.ground_truth_object(rec.wMc, estimator.r_seed);
   rec.visible_fraction = truth.visible_fraction;
   rec.occluders_in_sphere = truth.occluders_in_sphere;
   rec.sphere_distance_error = (rec.wMc.translation() - truth.centroid).norm() - r_sphere;
@@ -436,7 +439,8 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
     rendered.frame.timestamp = rec.time;
     rec.times.render = seconds_since(start);
 
-    ViewProblem gt_problem = record_truth(rec, renderer, loop.estimator());
+    ViewProblem gt_problem =
+        record_truth(rec, renderer, loop.estimator(), !plan && setup.perception == PerceptionMode::GroundTruth);
     rec.occluders_in_view = sim::occluders_seen(rendered.frame.labels);
 
     // The frame is as old as 1 + latency periods when its command is replaced.
@@ -538,7 +542,7 @@ EpisodeOutcome rehearse(const EpisodeSetup& setup, const volatile std::sig_atomi
     StepRecord rec;
     rec.time = f.frame->timestamp;
     rec.wMc = f.frame->wMc;
-    (void)record_truth(rec, renderer, estimator);  // the renderer is still at this frame's time
+    (void)record_truth(rec, renderer, estimator, false);  // the renderer is still at this frame's time
     rec.occluders_in_view = sim::occluders_seen(f.frame->labels);
     if (f.pose) rec.pose = pose_record(poses, *f.pose, rec.wMc);
     if (perception && f.pose) {
