@@ -5,10 +5,12 @@
 #include "point_grid.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 namespace ofv::perception {
@@ -36,6 +38,10 @@ double nearest_distance(const detail::PointGrid& grid, const std::vector<Eigen::
 
 }  // namespace
 
+struct VoxelLabels::Index {
+  detail::CellMap cells;
+};
+
 VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, double max_depth) {
   check_frame(frame);
   if (frame.labels.empty()) {
@@ -50,8 +56,17 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
   const CameraIntrinsics& k = frame.intrinsics;
   const Eigen::Matrix3f wRc = frame.wMc.linear().cast<float>();
   const Eigen::Vector3f wtc = frame.wMc.translation().cast<float>();
-  // Votes per cell: (label, count) pairs, a handful per cell at most.
-  std::vector<std::vector<std::pair<std::uint16_t, int>>> votes;
+  auto index = std::make_shared<Index>();
+  index->cells.reset(frame.depth.size() / static_cast<std::size_t>(stride * stride * 8));
+  // Votes per cell: (label, count), the first kInline in place (a cell
+  // shows one or two labels), any more in `more`.
+  constexpr int kInline = 4;
+  struct Votes {
+    std::array<std::pair<std::uint16_t, int>, kInline> inline_votes{};
+    int size = 0;
+  };
+  std::vector<Votes> votes;
+  std::unordered_map<std::size_t, std::vector<std::pair<std::uint16_t, int>>> more;
   std::vector<int> counts;
   std::uint64_t last_key = ~std::uint64_t{0};  // neighbouring pixels mostly share a cell
   std::size_t current = 0;  // its cell
@@ -64,52 +79,71 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
       const Eigen::Vector3f pw = wRc * pc + wtc;
       const std::uint64_t key = detail::cell_key(detail::cell_of(pw, inv_voxel_));
       if (key != last_key) {
-        const auto [it, inserted] = index_.try_emplace(key, static_cast<int>(cells_.size()));
-        if (inserted) {
+        int& cell = index->cells.find_or_insert(key);
+        if (cell < 0) {
+          cell = static_cast<int>(cells_.size());
           cells_.emplace_back();
           votes.emplace_back();
           counts.push_back(0);
         }
         last_key = key;
-        current = static_cast<std::size_t>(it->second);
+        current = static_cast<std::size_t>(cell);
       }
       const std::size_t c = current;
       cells_[c].mean += pw;
       ++counts[c];
-      auto& vote = votes[c];
+      Votes& vote = votes[c];
       const std::uint16_t label = frame.labels[i];
-      const auto found = std::find_if(vote.begin(), vote.end(), [label](const auto& x) { return x.first == label; });
-      if (found == vote.end()) {
-        vote.emplace_back(label, 1);
-      } else {
+      const auto in_place = vote.inline_votes.begin() + vote.size;
+      const auto found = std::find_if(vote.inline_votes.begin(), in_place, [label](const auto& x) { return x.first == label; });
+      if (found != in_place) {
         ++found->second;
+      } else if (vote.size < kInline) {
+        *in_place = {label, 1};
+        ++vote.size;
+      } else {
+        auto& rest = more[c];
+        const auto it = std::find_if(rest.begin(), rest.end(), [label](const auto& x) { return x.first == label; });
+        if (it == rest.end()) {
+          rest.emplace_back(label, 1);
+        } else {
+          ++it->second;
+        }
       }
     }
   }
+  // The most votes; a tie goes to the smaller label (deterministic).
+  const auto fewer = [](const auto& a, const auto& b) {
+    return a.second < b.second || (a.second == b.second && a.first > b.first);
+  };
   for (std::size_t c = 0; c < cells_.size(); ++c) {
     cells_[c].mean /= static_cast<float>(counts[c]);
-    // The most votes; a tie goes to the smaller label (deterministic).
-    const auto best = std::max_element(votes[c].begin(), votes[c].end(), [](const auto& a, const auto& b) {
-      return a.second < b.second || (a.second == b.second && a.first > b.first);
-    });
-    cells_[c].label = best->first;
+    const Votes& vote = votes[c];
+    auto best = *std::max_element(vote.inline_votes.begin(), vote.inline_votes.begin() + vote.size, fewer);
+    if (vote.size == kInline) {
+      if (const auto it = more.find(c); it != more.end()) {
+        best = std::max(best, *std::max_element(it->second.begin(), it->second.end(), fewer), fewer);
+      }
+    }
+    cells_[c].label = best.first;
   }
+  index_ = std::move(index);
 }
 
 int VoxelLabels::find(const Eigen::Vector3f& p) const {
   const Eigen::Vector3i c = detail::cell_of(p, inv_voxel_);
-  if (const auto it = index_.find(detail::cell_key(c)); it != index_.end()) return it->second;
+  if (const int at = index_->cells.find(detail::cell_key(c)); at >= 0) return at;
   int best = -1;
   float best_d2 = std::numeric_limits<float>::infinity();
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        const auto it = index_.find(detail::cell_key(c + Eigen::Vector3i(dx, dy, dz)));
-        if (it == index_.end()) continue;
-        const float d2 = (cells_[static_cast<std::size_t>(it->second)].mean - p).squaredNorm();
+        const int at = index_->cells.find(detail::cell_key(c + Eigen::Vector3i(dx, dy, dz)));
+        if (at < 0) continue;
+        const float d2 = (cells_[static_cast<std::size_t>(at)].mean - p).squaredNorm();
         if (d2 < best_d2) {
           best_d2 = d2;
-          best = it->second;
+          best = at;
         }
       }
     }

@@ -47,8 +47,8 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 namespace ofv::perception {
@@ -84,8 +84,9 @@ class VoxelLabels {
   [[nodiscard]] const std::vector<Cell>& cells() const { return cells_; }
 
  private:
+  struct Index;  // the occupied cells' hash
   float inv_voxel_ = 1.0f;
-  std::unordered_map<std::uint64_t, int> index_;
+  std::shared_ptr<const Index> index_;
   std::vector<Cell> cells_;
 };
 
