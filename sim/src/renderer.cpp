@@ -25,6 +25,9 @@ namespace ofv::sim {
 namespace {
 
 constexpr double kDegToRad = kPi / 180.0;
+// How far off its own surface's plane a visibility ray ends [m]: well above
+// the single-precision rounding of a scene a few metres across.
+constexpr double kSurfaceClearance = 1e-6;
 
 // A point on a mesh: triangle and barycentric coordinates (stays on the
 // surface when the mesh moves or deforms).
@@ -394,7 +397,8 @@ struct Renderer::Impl {
       filled = 0;
     };
     for (const WorldPoint& w : target.points) {
-      if (w.n.dot(o - w.p) <= 0.0) continue;
+      const double towards = w.n.dot(o - w.p);
+      if (towards <= 0.0) continue;
       ++facing;
       if (!all_in_view) {
         const Eigen::Vector3d pc = cMw * w.p;
@@ -412,7 +416,11 @@ struct Renderer::Impl {
       ray.dir_y[filled] = static_cast<float>(d.y());
       ray.dir_z[filled] = static_cast<float>(d.z());
       ray.tnear[filled] = 0.0f;
-      ray.tfar[filled] = static_cast<float>(1.0 - 1e-4);  // stop short of the point itself
+      // Stop short of the point itself, where the ray is still kSurfaceClearance
+      // off its surface's plane: a ray that grazes the surface (the camera
+      // within a hair of its plane) would otherwise meet the surface it ends on.
+      const double short_of = std::max(1e-4, kSurfaceClearance / towards);
+      ray.tfar[filled] = static_cast<float>(std::max(0.0, 1.0 - short_of));
       if (++filled == kPacket) trace();
     }
     if (filled > 0) trace();

@@ -377,6 +377,27 @@ TEST(Truth, VisibleFractionIsTheSameWhereNoShortcutApplies) {
   EXPECT_GT(part, 10);   // behind the hand, across the table's edge
 }
 
+TEST(Truth, AFaceSeenEdgeOnIsNotHiddenByItself) {
+  // A camera within a hair of the plane of the case's right face sees that
+  // face edge-on: the rays to its samples run along it. Nothing hides them
+  // (the ball inside the case only makes every ray be cast), so all of the
+  // case's facing samples are seen, as where no ray is needed.
+  const std::string object = "object: {shape: box, size: [0.19, 0.135, 0.015], position: [0, 0, 0.5]}\n";
+  const Renderer rays(scenario_from_yaml(
+      "sensor: {noise: {enabled: false}}\n" + object + "occluders: [{shape: sphere, radius: 0.004, position: [0, 0, 0.5]}]\n",
+      kSource));
+  const Renderer no_rays(scenario_from_yaml("sensor: {noise: {enabled: false}}\n" + object, kSource));
+  for (const double above : {1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3}) {
+    Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+    wMc.translation() = Eigen::Vector3d(0.095 + above, 0.0, 0.0);
+    const Eigen::Vector3d look = (Eigen::Vector3d(0, 0, 0.5) - wMc.translation()).normalized();
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(look).normalized();
+    wMc.linear() << x, look.cross(x), look;
+    EXPECT_EQ(no_rays.truth(wMc, 0.5).visible_fraction, 1.0) << above << " m off the face's plane";
+    EXPECT_EQ(rays.truth(wMc, 0.5).visible_fraction, 1.0) << above << " m off the face's plane";
+  }
+}
+
 // In front of the wall, beside the field of view, behind the wall, behind the camera.
 Scenario four_occluders() {
   return wall_scene(0.6,
