@@ -66,11 +66,23 @@ struct WorldPoint {
   Eigen::Vector3d p, n;  // position, outward unit normal
 };
 
-WorldPoint at(const TriangleMesh& m, const SurfaceSample& s) {
+// The outward unit normal of triangle t.
+Eigen::Vector3d normal_of(const TriangleMesh& m, std::size_t t) {
+  const auto& v = m.triangles[t];
+  const Eigen::Vector3d a = m.vertices[v[0]].cast<double>();
+  return (m.vertices[v[1]].cast<double>() - a).cross(m.vertices[v[2]].cast<double>() - a).normalized();
+}
+
+// Sample s of m, its triangle's normal given.
+WorldPoint at(const TriangleMesh& m, const SurfaceSample& s, const Eigen::Vector3d& normal) {
   const auto& t = m.triangles[static_cast<std::size_t>(s.triangle)];
   const Eigen::Vector3d a = m.vertices[t[0]].cast<double>(), b = m.vertices[t[1]].cast<double>(),
                         c = m.vertices[t[2]].cast<double>();
-  return {(1.0 - s.u - s.v) * a + s.u * b + s.v * c, (b - a).cross(c - a).normalized()};
+  return {(1.0 - s.u - s.v) * a + s.u * b + s.v * c, normal};
+}
+
+WorldPoint at(const TriangleMesh& m, const SurfaceSample& s) {
+  return at(m, s, normal_of(m, static_cast<std::size_t>(s.triangle)));
 }
 
 std::uint16_t label_of(const Body& b, int occluder_index) {
@@ -694,13 +706,19 @@ ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double 
   const Eigen::Vector3d c = p.positions.cols() > 0 ? Eigen::Vector3d(p.positions.rowwise().mean()) : mean;
 
   std::vector<WorldPoint> occluding;
+  std::vector<Eigen::Vector3d> normals;  // of the body's triangles, each made once
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     // Everything but the object and its holder (inside the augmented OBB anyway):
     // the occluders and the table, as the paper's classification would.
     const Role role = scenario_.bodies[b].role;
     if (role != Role::Occluder && role != Role::Background) continue;
+    if (impl_->boxes[b].exteriorDistance(c) > r_sphere + 1e-9) continue;  // wholly outside the sphere
+    const TriangleMesh& m = impl_->world[b];
+    normals.resize(m.triangles.size());
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) normals[t] = normal_of(m, t);
+    occluding.reserve(occluding.size() + impl_->samples[b].size());
     for (const auto& s : impl_->samples[b]) {
-      const WorldPoint w = at(impl_->world[b], s);
+      const WorldPoint w = at(m, s, normals[static_cast<std::size_t>(s.triangle)]);
       if (w.n.dot(o - w.p) <= 0.0) continue;  // the sensor sees only this side
       const bool in_obb = ((axes.transpose() * (w.p - mean)).cwiseAbs().array() <= half.array()).all();
       if (!in_obb && (w.p - c).norm() < r_sphere) occluding.push_back(w);
