@@ -705,18 +705,26 @@ ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double 
   const Eigen::Vector3d half = (axes.transpose() * centred).cwiseAbs().rowwise().maxCoeff().array() + obb_margin;
   const Eigen::Vector3d c = p.positions.cols() > 0 ? Eigen::Vector3d(p.positions.rowwise().mean()) : mean;
 
-  std::vector<WorldPoint> occluding;
-  std::vector<Eigen::Vector3d> normals;  // of the body's triangles, each made once
+  // Everything but the object and its holder (inside the augmented OBB
+  // anyway): the occluders and the table, as the paper's classification
+  // would; not the bodies wholly outside the sphere.
+  std::vector<std::size_t> bodies;
+  std::size_t samples = 0;
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
-    // Everything but the object and its holder (inside the augmented OBB anyway):
-    // the occluders and the table, as the paper's classification would.
     const Role role = scenario_.bodies[b].role;
-    if (role != Role::Occluder && role != Role::Background) continue;
-    if (impl_->boxes[b].exteriorDistance(c) > r_sphere + 1e-9) continue;  // wholly outside the sphere
+    if ((role != Role::Occluder && role != Role::Background) || impl_->boxes[b].exteriorDistance(c) > r_sphere + 1e-9) {
+      continue;
+    }
+    bodies.push_back(b);
+    samples += impl_->samples[b].size();
+  }
+  std::vector<WorldPoint> occluding;
+  occluding.reserve(samples);
+  std::vector<Eigen::Vector3d> normals;  // of the body's triangles, each made once
+  for (const std::size_t b : bodies) {
     const TriangleMesh& m = impl_->world[b];
     normals.resize(m.triangles.size());
     for (std::size_t t = 0; t < m.triangles.size(); ++t) normals[t] = normal_of(m, t);
-    occluding.reserve(occluding.size() + impl_->samples[b].size());
     for (const auto& s : impl_->samples[b]) {
       const WorldPoint w = at(m, s, normals[static_cast<std::size_t>(s.triangle)]);
       if (w.n.dot(o - w.p) <= 0.0) continue;  // the sensor sees only this side
