@@ -97,7 +97,7 @@ inline void pcd_header(const std::uint8_t* data, std::size_t size) {
   }
 }
 
-/// The .oni structure check in front of OpenNI2's player.
+/// The .oni structure check in front of a recording's playback.
 inline void oni(const std::uint8_t* data, std::size_t size) {
   std::istringstream in(text_of(data, size));
   try {

@@ -1,14 +1,17 @@
 // check_oni_file(): the structure of a .oni file, walked record by record
-// before OpenNI2's player sees it (the player trusts sizes, node ids and
-// offsets, and crashes on a single changed byte), and every compressed frame
-// decoded (oni_codecs.h): OpenNI2's decoders trust their payloads too.
+// (OpenNI2's player trusts sizes, node ids and offsets, and crashes on a single
+// changed byte), and every compressed frame decoded (oni_codecs.h): OpenNI2's
+// decoders trust their payloads too. The same walk indexes the file's nodes
+// and frames for OpenNi2Source's playback (oni_index.h).
 #include "ofv/sources/openni2_source.h"
 
 #include "oni_codecs.h"
 #include "oni_format.h"
+#include "oni_index.h"
 
 #include <OniCEnums.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -40,9 +43,13 @@ struct NodeState {
   std::uint64_t last_time = 0;
   std::uint64_t width = 0, height = 0, bytes_per_pixel = 0, required = 0;
   std::uint64_t crop_width = 0, crop_height = 0;  // 0: no cropping
+  std::uint64_t crop_x = 0, crop_y = 0;
+  std::uint64_t pixel_format = 0;
   std::set<std::uint64_t> data;  // NEW_DATA offsets
   std::set<std::string> properties;
   std::uint64_t table_found = 0;
+  std::uint64_t order = 0;  // when it was added: the index lists nodes in that order
+  NodeIndex index;
 };
 
 /// Reads the fields of one record, failing at the offset of the field that does not fit.
@@ -123,6 +130,10 @@ void check_oni_file(const std::string& path) {
 }
 
 void check_oni_file(std::istream& in, std::uint64_t size, const std::string& path) {
+  (void)oni::index_oni_file(in, size, path);
+}
+
+std::vector<oni::NodeIndex> oni::index_oni_file(std::istream& in, std::uint64_t size, const std::string& path) {
   const std::function<void(std::uint64_t, const std::string&)> fail = [&](std::uint64_t offset,
                                                                            const std::string& what) {
     throw std::invalid_argument(path + ": offset " + std::to_string(offset) + ": " + what);
@@ -152,6 +163,7 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
   std::vector<NodeState> nodes(max_node + 1);
   std::set<std::uint64_t> records;
   std::vector<std::uint8_t> decoded;  // a compressed frame, decoded: one at a time
+  std::uint64_t added = 0;
 
   std::uint64_t at = kFileHeaderBytes;
   for (bool end = false; !end;) {
@@ -188,6 +200,7 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
         if (node_type != kNodeTypeDepth && node_type != kNodeTypeImage && node_type != kNodeTypeIr) {
           fail(type_at, "node type " + std::to_string(node_type));
         }
+        n.index.type = node_type;
         const std::uint64_t codec_at = f.here();
         n.codec = f.get<std::uint32_t>("codec");
         if (n.codec != kCodecUncompressed && n.codec != kCodec16zTables && n.codec != kCodec16z && n.codec != kCodec8z &&
@@ -201,7 +214,9 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
         n.seek_table_at = f.here();
         n.seek_table = f.get<std::uint64_t>("seek table position");
         f.end();
+        n.index.codec = n.codec;
         n.added = true;
+        n.order = added++;
         break;
       }
       case kIntProperty:
@@ -234,6 +249,7 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
           std::uint64_t v;
           std::memcpy(&v, value, 8);
           if (name == "oniPixelFormat" && (n.bytes_per_pixel = bytes_per_pixel(v)) == 0) bad("pixel format " + std::to_string(v));
+          if (name == "oniPixelFormat") n.pixel_format = v;
           if (name == "oniRequiredFrameSize" && (v == 0 || v > kMaxPayloadBytes)) bad(std::to_string(v) + " bytes");
           if (name == "oniRequiredFrameSize") n.required = v;
         }
@@ -251,6 +267,8 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
           std::memcpy(c, value + 4, sizeof c);
           n.crop_width = u32(0) != 0 ? c[2] : 0;
           n.crop_height = u32(0) != 0 ? c[3] : 0;
+          n.crop_x = u32(0) != 0 ? c[0] : 0;
+          n.crop_y = u32(0) != 0 ? c[1] : 0;
           if (u32(0) > 1 || (u32(0) == 1 && (c[2] == 0 || c[3] == 0 || std::uint64_t{c[0]} + c[2] > n.width ||
                                              std::uint64_t{c[1]} + c[3] > n.height))) {
             bad("enabled " + std::to_string(u32(0)) + ", window outside the image");
@@ -261,6 +279,8 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
           if (bytes != 16) bad("size " + std::to_string(bytes) + ", expected 16");
           std::memcpy(fov, value, sizeof fov);
           if (!(fov[0] > 0.0 && fov[0] < 3.14) || !(fov[1] > 0.0 && fov[1] < 3.14)) bad("not in (0, pi)");
+          n.index.hfov = fov[0];
+          n.index.vfov = fov[1];
         }
         break;
       }
@@ -314,6 +334,9 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
           const std::string why = decode_frame(n.codec, read(at + fields_size, payload).data(), payload, shape, decoded);
           if (!why.empty()) fail(at + fields_size, why);
         }
+        n.index.frames.push_back({at + fields_size, payload, time, n.crop_width != 0 ? n.crop_width : n.width,
+                                  n.crop_width != 0 ? n.crop_height : n.height, n.crop_x, n.crop_y, n.width, n.height,
+                                  n.pixel_format, n.bytes_per_pixel});
         n.last_data = at;
         n.last_time = time;
         n.data.insert(at);
@@ -356,6 +379,14 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
       fail(n.seek_table_at, "seek table position " + std::to_string(n.seek_table) + " is not the node's seek table");
     }
   }
+  std::vector<NodeState*> added_nodes;
+  for (NodeState& n : nodes) {
+    if (n.added) added_nodes.push_back(&n);
+  }
+  std::sort(added_nodes.begin(), added_nodes.end(), [](const NodeState* a, const NodeState* b) { return a->order < b->order; });
+  std::vector<NodeIndex> index;
+  for (NodeState* n : added_nodes) index.push_back(std::move(n->index));
+  return index;
 }
 
 }  // namespace ofv

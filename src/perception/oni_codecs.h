@@ -1,8 +1,9 @@
 // The decoders of the compressed frames a .oni file may hold (the codecs of
 // OpenNI2's OniFile player), bounded: check_oni_file() decodes every
-// compressed payload with them before OpenNI2's own decoders, which trust the
-// payload (an escape at its end, a run or a table index past the frame, a JPEG
-// stream cut short), ever see it. Private to the perception library.
+// compressed payload with them (OpenNI2's own decoders trust the payload: an
+// escape at its end, a run or a table index past the frame, a JPEG stream cut
+// short), and OpenNi2Source plays recordings with them. Private to the
+// perception library.
 //
 // The byte formats (learned from OpenNI2's Source/Drivers/OniFile/Formats/, not
 // copied from it). Every 16-bit word is little-endian unless said otherwise.

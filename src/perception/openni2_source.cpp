@@ -1,12 +1,25 @@
-// OpenNI2 devices and .oni recordings (OpenNI 2.2 C++ API).
+// OpenNI2 devices (OpenNI 2.2 C++ API) and .oni recordings, which ofv plays
+// itself from the record format (oni_index.h) rather than through OpenNI2's
+// player, libOniFile. That player's thread walks the device's stream list
+// without a lock while a stream is destroyed, and is still at work for a
+// while after stop(): closing the device right after stop() crashed it ten
+// times in ten, and destroying the streams 50 ms after stop() crashed a CI
+// run once in its 251 plays of one test. Its seek crashes too. The walk that
+// checks every recording (check_oni_file) indexes it on the way.
 #include "ofv/sources/openni2_source.h"
+
+#include "oni_codecs.h"
+#include "oni_format.h"
+#include "oni_index.h"
 
 #include <OpenNI.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -53,20 +66,66 @@ bool looks_like_file(const std::string& uri) {
   return uri.size() > 4 && uri.compare(uri.size() - 4, 4, ".oni") == 0;
 }
 
-}  // namespace
+/// Metres per depth unit of an OpenNI2 pixel format; 0 for a format that is no depth.
+double depth_scale(int format) {
+  return format == openni::PIXEL_FORMAT_DEPTH_1_MM ? 1e-3 : format == openni::PIXEL_FORMAT_DEPTH_100_UM ? 1e-4 : 0.0;
+}
 
-struct OpenNi2Source::Impl {
+/// Pixels of an image: `width` x `height`, rows `stride` bytes apart.
+struct Image {
+  const std::uint8_t* data = nullptr;
+  int width = 0, height = 0, stride = 0;
+};
+
+/// `depth` (16-bit pixels) into `f.depth` [m]; `f.intrinsics` gives the size.
+void fill_depth(const Image& depth, double scale, RgbdFrame& f) {
+  f.depth.resize(static_cast<std::size_t>(depth.width) * static_cast<std::size_t>(depth.height));
+  for (int v = 0; v < depth.height; ++v) {
+    const std::uint8_t* row = depth.data + static_cast<std::size_t>(v) * static_cast<std::size_t>(depth.stride);
+    for (int u = 0; u < depth.width; ++u) {
+      std::uint16_t d;
+      std::memcpy(&d, row + 2 * u, 2);
+      f.depth[f.index(u, v)] = static_cast<float>(d * scale);
+    }
+  }
+}
+
+/// `colour` (RGB888) into `f.rgb` at the depth's size, nearest neighbour when the sizes differ.
+void fill_colour(const Image& colour, RgbdFrame& f) {
+  const int w = f.intrinsics.width, h = f.intrinsics.height;
+  f.rgb.resize(3 * static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  for (int v = 0; v < h; ++v) {
+    const std::uint8_t* row =
+        colour.data + static_cast<std::size_t>(v * colour.height / h) * static_cast<std::size_t>(colour.stride);
+    for (int u = 0; u < w; ++u) {
+      std::copy_n(row + 3 * (u * colour.width / w), 3, f.rgb.begin() + static_cast<std::ptrdiff_t>(3 * f.index(u, v)));
+    }
+  }
+}
+
+/// Intrinsics from fields of view [rad] over a `width` x `height` mode; the
+/// principal point at the mode's centre, less a cropping window's origin.
+CameraIntrinsics from_fov(const std::string& uri, double hfov, double vfov, int width, int height, double crop_x = 0.0,
+                          double crop_y = 0.0) {
+  CameraIntrinsics k;
+  k.fx = 0.5 * width / std::tan(0.5 * hfov);
+  k.fy = 0.5 * height / std::tan(0.5 * vfov);
+  k.cx = 0.5 * width - crop_x;
+  k.cy = 0.5 * height - crop_y;
+  if (!std::isfinite(k.fx) || !std::isfinite(k.fy) || !(k.fx > 0.0) || !(k.fy > 0.0)) {
+    throw std::runtime_error(uri + ": the depth stream reports no usable field of view; give the intrinsics");
+  }
+  return k;
+}
+
+/// A live OpenNI2 device and its streams.
+struct Device {
   openni::Device device;
   openni::VideoStream depth;
   openni::VideoStream colour;
   bool has_colour = false;
-  bool file = false;
-  int frames = 0;  // depth frames in a recording
-  int read = 0;    // depth frames read so far
-  std::vector<StampedPose> poses;
-  double first_timestamp = -1.0;
 
-  ~Impl() {
+  ~Device() {
     if (depth.isValid()) {
       depth.stop();
     }
@@ -82,75 +141,144 @@ struct OpenNi2Source::Impl {
   }
 };
 
+/// A .oni recording: its nodes, and the file its frames are read from.
+struct Recording {
+  std::ifstream file;
+  const oni::NodeIndex* depth = nullptr;
+  const oni::NodeIndex* colour = nullptr;
+  std::vector<oni::NodeIndex> nodes;
+  std::vector<std::uint8_t> payload, decoded;
+
+  /// The pixels of frame `k` of `node`, read (and decoded) into `decoded`.
+  Image frame(const std::string& path, const oni::NodeIndex& node, std::size_t k) {
+    const oni::FrameRecord& r = node.frames[k];
+    payload.resize(r.bytes);
+    file.clear();
+    file.seekg(static_cast<std::streamoff>(r.offset));
+    file.read(reinterpret_cast<char*>(payload.data()), static_cast<std::streamsize>(r.bytes));
+    if (!file) throw std::runtime_error(path + ": cannot read the frame at offset " + std::to_string(r.offset));
+    const oni::FrameShape shape{r.width, r.height, r.bytes_per_pixel};
+    if (node.codec == oni::kCodecUncompressed) {
+      if (r.bytes != shape.bytes()) throw std::runtime_error(path + ": the frame at offset " + std::to_string(r.offset) + " changed since it was checked");
+      decoded.swap(payload);
+    } else {
+      const std::string why = oni::decode_frame(node.codec, payload.data(), payload.size(), shape, decoded);
+      if (!why.empty()) throw std::runtime_error(path + ": offset " + std::to_string(r.offset) + ": " + why);
+    }
+    return {decoded.data(), static_cast<int>(r.width), static_cast<int>(r.height),
+            static_cast<int>(r.width * r.bytes_per_pixel)};
+  }
+};
+
+}  // namespace
+
+struct OpenNi2Source::Impl {
+  std::unique_ptr<Device> live;
+  std::unique_ptr<Recording> recording;
+  std::vector<StampedPose> poses;
+  std::size_t next = 0;  // a recording's next depth frame
+  int read = 0;          // frames given
+  double first_timestamp = -1.0;
+  std::chrono::steady_clock::time_point started;  // of a paced playback
+};
+
 OpenNi2Source::OpenNi2Source(const std::string& uri, const OpenNi2Options& options)
     : uri_(uri), options_(options) {
-  rewind();
+  impl_ = std::make_unique<Impl>();
+  if (looks_like_file(uri_)) {
+    open_recording();
+  } else {
+    open_device();
+  }
 }
 
 OpenNi2Source::~OpenNi2Source() = default;
 
-void OpenNi2Source::rewind() {
-  impl_.reset();
-  if (looks_like_file(uri_) && !fs::is_regular_file(uri_)) {
+void OpenNi2Source::open_recording() {
+  if (!fs::is_regular_file(uri_)) {
     throw std::runtime_error(uri_ + ": no such .oni file");
   }
-  if (looks_like_file(uri_)) {
-    check_oni_file(uri_);  // OpenNI2 never sees a malformed record
+  auto rec = std::make_unique<Recording>();
+  rec->file.open(uri_, std::ios::binary);
+  std::error_code ec;
+  const std::uint64_t size = fs::file_size(uri_, ec);
+  if (!rec->file || ec) throw std::runtime_error(uri_ + ": cannot read the .oni file");
+  rec->nodes = oni::index_oni_file(rec->file, size, uri_);  // never plays a malformed record
+  for (const oni::NodeIndex& n : rec->nodes) {
+    if (n.type == oni::kNodeTypeDepth && rec->depth == nullptr) rec->depth = &n;
+    if (n.type == oni::kNodeTypeImage && rec->colour == nullptr && options_.colour && !n.frames.empty()) rec->colour = &n;
   }
+  if (rec->depth == nullptr) throw std::runtime_error(uri_ + ": no depth stream");
+  for (const oni::NodeIndex* n : {rec->depth, rec->colour}) {
+    if (n == nullptr) continue;
+    for (const oni::FrameRecord& r : n->frames) {
+      const bool ok = n == rec->depth ? depth_scale(static_cast<int>(r.pixel_format)) != 0.0
+                                      : r.pixel_format == static_cast<std::uint64_t>(openni::PIXEL_FORMAT_RGB888);
+      if (!ok) {
+        throw std::runtime_error(uri_ + ": unsupported " + (n == rec->depth ? "depth" : "colour") + " pixel format " +
+                                 std::to_string(r.pixel_format));
+      }
+    }
+  }
+  const std::string poses = uri_ + ".poses.txt";
+  if (fs::exists(poses)) {
+    impl_->poses = read_pose_file(poses);
+    if (impl_->poses.size() < rec->depth->frames.size()) {
+      throw std::invalid_argument(poses + ": " + std::to_string(impl_->poses.size()) + " poses for " +
+                                  std::to_string(rec->depth->frames.size()) + " frames");
+    }
+  }
+  impl_->recording = std::move(rec);
+}
+
+void OpenNi2Source::open_device() {
   initialise_openni();
-  auto impl = std::make_unique<Impl>();
-  if (impl->device.open(uri_.empty() ? openni::ANY_DEVICE : uri_.c_str()) != openni::STATUS_OK) {
+  auto dev = std::make_unique<Device>();
+  if (dev->device.open(uri_.empty() ? openni::ANY_DEVICE : uri_.c_str()) != openni::STATUS_OK) {
     throw std::runtime_error((uri_.empty() ? std::string("first OpenNI2 device") : uri_) +
                              ": cannot open the OpenNI2 device or recording: " + last_error());
   }
-  impl->file = impl->device.isFile();
-  if (!impl->device.hasSensor(openni::SENSOR_DEPTH) ||
-      impl->depth.create(impl->device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
+  if (!dev->device.hasSensor(openni::SENSOR_DEPTH) ||
+      dev->depth.create(dev->device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
     throw std::runtime_error(uri_ + ": no depth stream: " + last_error());
   }
-  if (options_.colour && impl->device.hasSensor(openni::SENSOR_COLOR) &&
-      impl->colour.create(impl->device, openni::SENSOR_COLOR) == openni::STATUS_OK) {
-    impl->has_colour = true;
+  if (options_.colour && dev->device.hasSensor(openni::SENSOR_COLOR) &&
+      dev->colour.create(dev->device, openni::SENSOR_COLOR) == openni::STATUS_OK) {
+    dev->has_colour = true;
   }
-  if (impl->file) {
-    openni::PlaybackControl* playback = impl->device.getPlaybackControl();
-    playback->setRepeatEnabled(false);
-    playback->setSpeed(options_.playback_speed);
-    impl->frames = playback->getNumberOfFrames(impl->depth);
-    const std::string poses = uri_ + ".poses.txt";
-    if (fs::exists(poses)) {
-      impl->poses = read_pose_file(poses);
-      if (impl->poses.size() < static_cast<std::size_t>(impl->frames)) {
-        throw std::invalid_argument(poses + ": " + std::to_string(impl->poses.size()) + " poses for " +
-                                    std::to_string(impl->frames) + " frames");
-      }
-    }
-  } else {
-    if (options_.registration && impl->has_colour &&
-        impl->device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
-      impl->device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR);
-    }
-    if (impl->has_colour) {
-      impl->device.setDepthColorSyncEnabled(true);
-    }
+  if (options_.registration && dev->has_colour &&
+      dev->device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
+    dev->device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR);
   }
-  if (impl->depth.start() != openni::STATUS_OK) {
+  if (dev->has_colour) {
+    dev->device.setDepthColorSyncEnabled(true);
+  }
+  if (dev->depth.start() != openni::STATUS_OK) {
     throw std::runtime_error(uri_ + ": cannot start the depth stream: " + last_error());
   }
-  if (impl->has_colour && impl->colour.start() != openni::STATUS_OK) {
+  if (dev->has_colour && dev->colour.start() != openni::STATUS_OK) {
     throw std::runtime_error(uri_ + ": cannot start the colour stream: " + last_error());
   }
-  impl_ = std::move(impl);
+  impl_->live = std::move(dev);
 }
 
-bool OpenNi2Source::is_file() const { return impl_->file; }
+void OpenNi2Source::rewind() {
+  if (impl_->recording) {
+    impl_->next = 0;
+    impl_->read = 0;
+    impl_->first_timestamp = -1.0;
+  }
+}
 
-int OpenNi2Source::number_of_frames() const { return impl_->frames; }
+bool OpenNi2Source::is_file() const { return impl_->recording != nullptr; }
+
+int OpenNi2Source::number_of_frames() const {
+  return impl_->recording ? static_cast<int>(impl_->recording->depth->frames.size()) : 0;
+}
 
 std::string OpenNi2Source::describe() const {
-  return impl_->file
-             ? "OpenNI2 recording " + uri_ + " (" + std::to_string(impl_->frames) + " frames)"
-             : "OpenNI2 device " + uri_;
+  return impl_->recording ? "OpenNI2 recording " + uri_ + " (" + std::to_string(number_of_frames()) + " frames)"
+                          : "OpenNI2 device " + uri_;
 }
 
 namespace {
@@ -168,19 +296,77 @@ bool read_frame(openni::VideoStream& stream, openni::VideoFrameRef& frame, int t
 }  // namespace
 
 std::optional<RgbdFrame> OpenNi2Source::next() {
+  std::optional<RgbdFrame> f = impl_->recording ? next_recorded() : next_live();
+  if (!f) return f;
+  if (impl_->first_timestamp < 0.0) {
+    impl_->first_timestamp = f->timestamp;
+  }
+  f->timestamp -= impl_->first_timestamp;
+  ++impl_->read;
+  return f;
+}
+
+std::optional<RgbdFrame> OpenNi2Source::next_recorded() {
   Impl& s = *impl_;
-  if (s.file && s.read >= s.frames) {
+  Recording& rec = *s.recording;
+  const std::vector<oni::FrameRecord>& frames = rec.depth->frames;
+  if (s.next >= frames.size()) {
     return std::nullopt;
   }
+  if (options_.playback_speed > 0.0f) {
+    // Paced like the sensor was: frame k is due (its time - the first's) /
+    // speed after the first; frames already past due give way to the last
+    // one due, as a live stream's would to a consumer that fell behind.
+    const auto due = [&](std::size_t k) {
+      const double after = static_cast<double>(frames[k].time_us - frames.front().time_us) * 1e-6 / options_.playback_speed;
+      return s.started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(after));
+    };
+    if (s.next == 0) s.started = std::chrono::steady_clock::now();
+    const auto now = std::chrono::steady_clock::now();
+    while (s.next + 1 < frames.size() && due(s.next + 1) <= now) ++s.next;
+    std::this_thread::sleep_until(due(s.next));
+  }
+  const std::size_t k = s.next++;
+  const oni::FrameRecord& r = frames[k];
+  RgbdFrame f;
+  if (options_.intrinsics) {
+    f.intrinsics = *options_.intrinsics;
+    if (static_cast<std::uint64_t>(f.intrinsics.width) != r.width ||
+        static_cast<std::uint64_t>(f.intrinsics.height) != r.height) {
+      throw BadFrame(uri_ + ": a frame is " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                     ", the given intrinsics " + std::to_string(f.intrinsics.width) + "x" +
+                     std::to_string(f.intrinsics.height));
+    }
+  } else {
+    f.intrinsics = from_fov(uri_, rec.depth->hfov, rec.depth->vfov, static_cast<int>(r.mode_width),
+                            static_cast<int>(r.mode_height), static_cast<double>(r.crop_x), static_cast<double>(r.crop_y));
+    f.intrinsics.width = static_cast<int>(r.width);
+    f.intrinsics.height = static_cast<int>(r.height);
+  }
+  f.timestamp = static_cast<double>(r.time_us) * 1e-6;
+  fill_depth(rec.frame(uri_, *rec.depth, k), depth_scale(static_cast<int>(r.pixel_format)), f);
+  if (rec.colour != nullptr) {
+    // The colour frame nearest in time (the earlier of two as near).
+    const std::vector<oni::FrameRecord>& c = rec.colour->frames;
+    const auto after = std::lower_bound(c.begin(), c.end(), r.time_us,
+                                        [](const oni::FrameRecord& x, std::uint64_t t) { return x.time_us < t; });
+    std::size_t j = static_cast<std::size_t>(after - c.begin());
+    if (j == c.size() || (j > 0 && r.time_us - c[j - 1].time_us <= c[j].time_us - r.time_us)) --j;
+    fill_colour(rec.frame(uri_, *rec.colour, j), f);
+  }
+  if (!s.poses.empty()) {
+    f.wMc = s.poses[k].wMc;  // frame k of a recording made by OniWriter has pose line k
+  }
+  return f;
+}
+
+std::optional<RgbdFrame> OpenNi2Source::next_live() {
+  Device& s = *impl_->live;
   openni::VideoFrameRef depth;
   if (!read_frame(s.depth, depth, options_.timeout_ms)) {
     throw std::runtime_error(uri_ + ": no depth frame within " +
                              std::to_string(options_.timeout_ms) + " ms: " + last_error());
   }
-  ++s.read;
-  const auto depth_scale = [](openni::PixelFormat format) {
-    return format == openni::PIXEL_FORMAT_DEPTH_1_MM ? 1e-3 : format == openni::PIXEL_FORMAT_DEPTH_100_UM ? 1e-4 : 0.0;
-  };
   const double scale = depth_scale(depth.getVideoMode().getPixelFormat());
   if (scale == 0.0) {
     const std::string why = uri_ + ": unsupported depth pixel format " +
@@ -203,39 +389,17 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
                                std::to_string(f.intrinsics.height));
     }
   } else {
+    f.intrinsics = from_fov(uri_, s.depth.getHorizontalFieldOfView(), s.depth.getVerticalFieldOfView(), w, h);
     f.intrinsics.width = w;
     f.intrinsics.height = h;
-    f.intrinsics.fx = 0.5 * w / std::tan(0.5 * s.depth.getHorizontalFieldOfView());
-    f.intrinsics.fy = 0.5 * h / std::tan(0.5 * s.depth.getVerticalFieldOfView());
-    f.intrinsics.cx = 0.5 * w;
-    f.intrinsics.cy = 0.5 * h;
-    if (!std::isfinite(f.intrinsics.fx) || !std::isfinite(f.intrinsics.fy) ||
-        !(f.intrinsics.fx > 0.0) || !(f.intrinsics.fy > 0.0)) {
-      throw std::runtime_error(uri_ +
-                               ": the depth stream reports no usable field of view; "
-                               "give the intrinsics");
-    }
   }
-  const double t = static_cast<double>(depth.getTimestamp()) * 1e-6;
-  if (s.first_timestamp < 0.0) {
-    s.first_timestamp = t;
-  }
-  f.timestamp = t - s.first_timestamp;
-  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  f.timestamp = static_cast<double>(depth.getTimestamp()) * 1e-6;
   if (depth.getData() == nullptr || depth.getStrideInBytes() < static_cast<int>(w * sizeof(openni::DepthPixel)) ||
       static_cast<std::size_t>(depth.getDataSize()) < static_cast<std::size_t>(depth.getStrideInBytes()) * h) {
     throw BadFrame(uri_ + ": a depth frame of " + std::to_string(depth.getDataSize()) + " bytes for " +
                    std::to_string(w) + "x" + std::to_string(h) + " pixels (a short read)");
   }
-  f.depth.resize(n);
-  const auto* bytes = static_cast<const std::uint8_t*>(depth.getData());
-  for (int v = 0; v < h; ++v) {
-    const auto* row = reinterpret_cast<const openni::DepthPixel*>(
-        bytes + static_cast<std::size_t>(v) * static_cast<std::size_t>(depth.getStrideInBytes()));
-    for (int u = 0; u < w; ++u) {
-      f.depth[f.index(u, v)] = static_cast<float>(row[u] * scale);
-    }
-  }
+  fill_depth({static_cast<const std::uint8_t*>(depth.getData()), w, h, depth.getStrideInBytes()}, scale, f);
   if (s.has_colour) {
     openni::VideoFrameRef colour;
     if (!read_frame(s.colour, colour, options_.timeout_ms)) {
@@ -247,25 +411,13 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
           uri_ + ": unsupported colour pixel format " +
           std::to_string(static_cast<int>(colour.getVideoMode().getPixelFormat())));
     }
-    const int cw = colour.getWidth();
-    const int ch = colour.getHeight();
-    const auto* cbytes = static_cast<const std::uint8_t*>(colour.getData());
-    f.rgb.resize(3 * n);
-    for (int v = 0; v < h; ++v) {
-      const int cv = v * ch / h;  // nearest neighbour when the sizes differ
-      const std::uint8_t* row = cbytes + static_cast<std::size_t>(cv) *
-                                             static_cast<std::size_t>(colour.getStrideInBytes());
-      for (int u = 0; u < w; ++u) {
-        const int cu = u * cw / w;
-        std::copy_n(row + 3 * cu, 3,
-                    f.rgb.begin() + static_cast<std::ptrdiff_t>(3 * f.index(u, v)));
-      }
+    const int cw = colour.getWidth(), ch = colour.getHeight();
+    if (colour.getData() == nullptr || colour.getStrideInBytes() < 3 * cw ||
+        static_cast<std::size_t>(colour.getDataSize()) < static_cast<std::size_t>(colour.getStrideInBytes()) * ch) {
+      throw BadFrame(uri_ + ": a colour frame of " + std::to_string(colour.getDataSize()) + " bytes for " +
+                     std::to_string(cw) + "x" + std::to_string(ch) + " pixels (a short read)");
     }
-  }
-  if (!s.poses.empty()) {
-    // Frame i of a recording made by OniWriter has pose line i.
-    const auto i = static_cast<std::size_t>(s.read - 1);
-    f.wMc = s.poses[std::min(i, s.poses.size() - 1)].wMc;  // as many poses as frames (rewind)
+    fill_colour({static_cast<const std::uint8_t*>(colour.getData()), cw, ch, colour.getStrideInBytes()}, f);
   }
   return f;
 }

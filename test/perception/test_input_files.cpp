@@ -205,8 +205,9 @@ TEST(InputFiles, OniWithAnyHeaderByteChangedIsRefusedOrPlays) {
         refused_offsets.push_back(k);
         continue;
       }
-      // Accepted: OpenNI2 plays it, or reports an error; it must not crash.
-      // (Once in CI it did, with nothing said: the line names the mutation.)
+      // Accepted: it plays, or the source reports an error; it must not crash.
+      // (OpenNI2's player, which played recordings before ofv did, crashed
+      // twice in CI here: the line names the mutation.)
       std::cerr << "playing the mutation of byte " << k << (change == 0 ? " (flipped)" : " (+1)") << '\n';
       try {
         OpenNi2Source source(path.string(), options);

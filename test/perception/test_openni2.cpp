@@ -1,17 +1,20 @@
-// OpenNI2: .oni files written by OniWriter and played back by OpenNI2's own
-// player (libOniFile), the DummyDevice driver, and errors.
+// OpenNI2: .oni files written by OniWriter and played back by ofv, as
+// OpenNI2's own player (libOniFile) plays them; the DummyDevice driver, and errors.
 #include "ofv/sources/openni2_source.h"
 
+#include "openni2_player.h"
 #include "scratch.h"
 #include "synthetic_scene.h"
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -74,9 +77,57 @@ TEST(OpenNi2, OniWrittenDirectlyPlaysBackFrameByFrame) {
   EXPECT_EQ(source.number_of_frames(), 5);
   EXPECT_NE(source.describe().find(path), std::string::npos);
   expect_played_back(source, frames);
-  // Rewind (close and reopen: OpenNI2's seek crashes) and play again.
   source.rewind();
   expect_played_back(source, frames);
+}
+
+TEST(OpenNi2, OfvPlaysARecordingAsOpenNi2sOwnPlayerDoes) {
+  const auto frames = moving_case(3);
+  const std::string path = write_oni("ofv_perception_interop.oni", frames);
+  const test::OpenNi2Playback theirs = test::play_with_openni2(path);
+  ASSERT_EQ(theirs.depth.size(), frames.size());
+  ASSERT_EQ(theirs.rgb.size(), frames.size());
+  OpenNi2Source source(path);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const auto f = source.next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->intrinsics.width, theirs.width);
+    ASSERT_EQ(f->intrinsics.height, theirs.height);
+    EXPECT_NEAR(f->intrinsics.fx, 0.5 * theirs.width / std::tan(0.5 * theirs.hfov), 1e-3);
+    EXPECT_NEAR(f->intrinsics.fy, 0.5 * theirs.height / std::tan(0.5 * theirs.vfov), 1e-3);
+    EXPECT_NEAR(f->timestamp, static_cast<double>(theirs.time_us[k] - theirs.time_us[0]) * 1e-6, 1e-9);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < f->depth.size(); ++i) {
+      differ += f->depth[i] == static_cast<float>(theirs.depth[k][i] * 1e-3) ? 0 : 1;
+    }
+    EXPECT_EQ(differ, 0u) << "frame " << k;
+    EXPECT_EQ(f->rgb, theirs.rgb[k]) << "frame " << k;
+  }
+}
+
+TEST(OpenNi2, RealTimePlaybackKeepsTheRecordingsPaceAndSkipsWhatIsPastDue) {
+  const auto frames = moving_case(8);  // at 30 fps: 233 ms from the first frame to the last
+  const std::string path = write_oni("ofv_perception_paced.oni", frames);
+  OpenNi2Options options;
+  options.playback_speed = 2.0f;
+  OpenNi2Source source(path, options);
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < 4; ++k) {
+    const auto f = source.next();
+    ASSERT_TRUE(f);
+    EXPECT_NEAR(f->timestamp, frames[k].timestamp, 1e-5);
+  }
+  // Frame 3 is due 50 ms after the first at twice the speed: never sooner.
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(49));
+  // A reader that falls 80 ms behind gets the newest frame due, not the next one.
+  std::this_thread::sleep_for(std::chrono::milliseconds(80));
+  const auto late = source.next();
+  ASSERT_TRUE(late);
+  EXPECT_GE(late->timestamp, frames[5].timestamp - 1e-5);
+  EXPECT_TRUE(late->wMc.isApprox(frames[static_cast<std::size_t>(std::lround(late->timestamp * 30.0))].wMc, 1e-6));
+  int rest = 0;
+  while (source.next()) ++rest;
+  EXPECT_LE(rest, 2);
 }
 
 TEST(OpenNi2, DepthOnlyRecording) {

@@ -30,17 +30,18 @@ struct OpenNi2Options {
   /// Map depth onto the colour image (live devices that support it; a
   /// recording keeps whatever registration it was made with).
   bool registration = true;
-  /// Recordings only: 1 = real time, 2 = twice as fast, 0 = as fast as
-  /// possible, -1 = one frame each time next() asks (no frame is skipped).
+  /// Recordings only: 1 = real time, 2 = twice as fast (frames that are
+  /// past due when next() asks give way to the newest due one, as a live
+  /// sensor's would); 0 or -1 = every frame, each as soon as next() asks.
   float playback_speed = -1.0f;
-  int timeout_ms = 3000;                       ///< longest wait for a frame [ms]
+  int timeout_ms = 3000;                       ///< devices only: longest wait for a frame [ms]
   std::optional<CameraIntrinsics> intrinsics;  ///< overrides the fields of view
   bool colour = true;                          ///< also read the colour stream when there is one
 };
 
 /**
- * \brief Checks the structure of a `.oni` file (OpenNI2 file format 1.0.1.0)
- *        before OpenNI2's player, which trusts it, reads it.
+ * \brief Checks the structure of a `.oni` file (OpenNI2 file format 1.0.1.0),
+ *        as OpenNi2Source does before it plays one.
  *
  * The file header (magic NI10, version 1.0.1.0, at most 16 nodes) and every
  * record up to END: magic, known type, node id added and within the header's
@@ -64,15 +65,19 @@ void check_oni_file(std::istream& in, std::uint64_t size, const std::string& pat
  *        `Dummy`) or a `.oni` file.
  *
  * Depth 1 mm or 100 um and RGB888 colour are supported; colour of another
- * size than depth is resized (nearest neighbour). Rewind a recording with
- * rewind(): OpenNI2's seek crashes inside libOniFile, so it closes and
- * reopens the file.
+ * size than depth is resized (nearest neighbour). A device is read through
+ * OpenNI2. A `.oni` recording is played by ofv itself, after
+ * check_oni_file(), from OpenNI2's record format (uncompressed, 16zP, 16zT,
+ * Im8z and JPEG frames), each depth frame with the colour frame nearest in
+ * time: OpenNI2's own player (libOniFile) crashes when its streams are
+ * destroyed or its device closed soon after they stop, and on seek.
  */
 class OpenNi2Source : public FrameSource {
  public:
-  /// An empty URI opens the first device OpenNI2 finds.
+  /// An empty URI opens the first device OpenNI2 finds; a URI ending in `.oni` is a recording.
   /// \throws std::runtime_error naming the URI or path when OpenNI2 cannot
-  /// initialise, the device or file cannot be opened, or it has no depth stream;
+  /// initialise, the device or file cannot be opened, it has no depth stream,
+  /// or a recording's depth or colour pixel format is not supported;
   /// std::invalid_argument when a file fails check_oni_file() or its poses file
   /// has fewer poses than the recording has frames.
   explicit OpenNi2Source(const std::string& uri, const OpenNi2Options& options = {});
@@ -81,18 +86,24 @@ class OpenNi2Source : public FrameSource {
   OpenNi2Source& operator=(const OpenNi2Source&) = delete;
 
   /// The next frame; std::nullopt at the end of a recording.
-  /// \throws std::runtime_error naming the URI when a frame does not arrive in time.
+  /// \throws std::runtime_error naming the URI when a device's frame does not
+  /// arrive in time, or a recording's file can no longer be read as checked;
+  /// BadFrame when a frame does not have the size of the given intrinsics.
   std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::string describe() const override;
   /// True for a `.oni` recording.
   [[nodiscard]] bool is_file() const;
   /// Depth frames in a recording (0 for a live device).
   [[nodiscard]] int number_of_frames() const;
-  /// Starts a recording again from its first frame (close and reopen).
+  /// Starts a recording again from its first frame; no effect on a device.
   void rewind();
 
  private:
   struct Impl;
+  void open_recording();
+  void open_device();
+  std::optional<RgbdFrame> next_recorded();
+  std::optional<RgbdFrame> next_live();
   std::string uri_;
   OpenNi2Options options_;
   std::unique_ptr<Impl> impl_;
