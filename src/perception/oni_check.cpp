@@ -317,8 +317,9 @@ std::vector<oni::NodeIndex> oni::index_oni_file(std::istream& in, std::uint64_t 
             fail(at, "frame of node " + std::to_string(id) + " before its property " + needed);
           }
         }
-        const std::uint64_t pixels = n.crop_width != 0 ? n.crop_width * n.crop_height : n.width * n.height;
-        const std::uint64_t expected = pixels * n.bytes_per_pixel;
+        const FrameShape shape{n.crop_width != 0 ? n.crop_width : n.width, n.crop_width != 0 ? n.crop_height : n.height,
+                               n.bytes_per_pixel};
+        const std::uint64_t expected = shape.bytes();
         if (n.codec == kCodecUncompressed && (payload != expected || n.required != expected)) {
           fail(at + 16, "payload size " + std::to_string(payload) + ", the node's mode and pixel format need " + std::to_string(expected));
         }
@@ -329,14 +330,11 @@ std::vector<oni::NodeIndex> oni::index_oni_file(std::istream& in, std::uint64_t 
                          ", the node's mode and pixel format need " + std::to_string(expected));
           }
           // OpenNI2's decoders trust the payload: it must decode, bounded, to exactly that frame.
-          const FrameShape shape{n.crop_width != 0 ? n.crop_width : n.width, n.crop_width != 0 ? n.crop_height : n.height,
-                                 n.bytes_per_pixel};
           const std::string why = decode_frame(n.codec, read(at + fields_size, payload).data(), payload, shape, decoded);
           if (!why.empty()) fail(at + fields_size, why);
         }
-        n.index.frames.push_back({at + fields_size, payload, time, n.crop_width != 0 ? n.crop_width : n.width,
-                                  n.crop_width != 0 ? n.crop_height : n.height, n.crop_x, n.crop_y, n.width, n.height,
-                                  n.pixel_format, n.bytes_per_pixel});
+        n.index.frames.push_back({at + fields_size, payload, time, shape.width, shape.height, n.crop_x, n.crop_y, n.width,
+                                  n.height, n.pixel_format, n.bytes_per_pixel});
         n.last_data = at;
         n.last_time = time;
         n.data.insert(at);

@@ -427,6 +427,10 @@ std::vector<RgbdFrame> played(const std::string& path) {
   while (auto f = source.next()) frames.push_back(*f);
   const test::OpenNi2Playback theirs = test::play_with_openni2(path);
   EXPECT_EQ(theirs.depth.size(), frames.size()) << path;
+  if (!frames.empty()) {
+    EXPECT_EQ(frames[0].intrinsics.width, theirs.width) << path;
+    EXPECT_EQ(frames[0].intrinsics.height, theirs.height) << path;
+  }
   for (std::size_t k = 0; k < std::min(frames.size(), theirs.depth.size()); ++k) {
     std::size_t differ = 0;
     for (std::size_t i = 0; i < frames[k].depth.size(); ++i) {
@@ -543,6 +547,59 @@ TEST(OniCodecs, CompressedColourNodesPassTheCheckAndPlayAsInOpenNi2) {
     }, at));
     EXPECT_NE(refusal(path).find(path + ": offset " + std::to_string(at[2]) + ": JPEG payload: "), std::string::npos)
         << refusal(path);
+  }
+}
+
+/// The offset of the value of node `node`'s property `name` (type `type`) in an OniWriter file.
+std::size_t property_value_at(const std::string& file, std::uint32_t node, std::uint32_t type, const std::string& name) {
+  for (std::size_t at = oni::kFileHeaderBytes; at + oni::kRecordHeaderBytes <= file.size();) {
+    const auto fields = get<std::uint32_t>(file, at + 12), payload = get<std::uint32_t>(file, at + 16);
+    const std::size_t name_at = at + oni::kRecordHeaderBytes + 4;
+    if (get<std::uint32_t>(file, at + 4) == type && get<std::uint32_t>(file, at + 8) == node &&
+        file.compare(name_at, name.size() + 1, name.c_str(), name.size() + 1) == 0) {
+      return name_at + name.size() + 1 + 4;  // past the name and the value's size
+    }
+    at += fields + payload;
+  }
+  ADD_FAILURE() << "no property " << name << " of node " << node;
+  return 0;
+}
+
+TEST(OniCodecs, ACroppedDepthNodePlaysItsWindowAsInOpenNi2) {
+  const std::vector<RgbdFrame> full = three_frames(false);
+  const std::string plain = write_oni("ofv_plain_uncropped.oni", full);
+  const int w = full[0].intrinsics.width;
+  // The depth node cropped to the 60 x 40 window at (30, 20): its frames hold that window only.
+  std::string bytes = file_text(plain);
+  const std::size_t cropping = property_value_at(bytes, 1, oni::kGeneralProperty, "xnCropping");
+  set(bytes, cropping, std::uint32_t{1});
+  for (const auto& [k, v] : std::vector<std::pair<int, std::uint16_t>>{{0, 30}, {1, 20}, {2, 60}, {3, 40}}) {
+    set(bytes, cropping + 4 + 2 * k, v);
+  }
+  set(bytes, property_value_at(bytes, 1, oni::kIntProperty, "oniRequiredFrameSize"), std::uint64_t{60 * 40 * 2});
+  std::vector<std::size_t> at;
+  const std::string path = spit("ofv_cropped.oni", recode(bytes, 1, oni::kCodecUncompressed, [&](int, const Bytes& p) {
+    Bytes window;
+    for (int v = 20; v < 60; ++v) window.insert(window.end(), p.begin() + 2 * (v * w + 30), p.begin() + 2 * (v * w + 90));
+    return window;
+  }, at));
+  ASSERT_EQ(refusal(path), "");
+  const std::vector<RgbdFrame> frames = played(path);  // as OpenNI2 plays it, pixel for pixel
+  ASSERT_EQ(frames.size(), full.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const RgbdFrame& f = frames[k];
+    ASSERT_EQ(f.intrinsics.width, 60);
+    ASSERT_EQ(f.intrinsics.height, 40);
+    // The same camera: the principal point moves with the window, the focal lengths stay.
+    EXPECT_NEAR(f.intrinsics.fx, full[k].intrinsics.fx, 1e-3);
+    EXPECT_NEAR(f.intrinsics.cx, 0.5 * w - 30, 1e-9);
+    EXPECT_NEAR(f.intrinsics.cy, 0.5 * full[k].intrinsics.height - 20, 1e-9);
+    for (int v = 0; v < 40; ++v) {
+      for (int u = 0; u < 60; ++u) {
+        ASSERT_NEAR(f.depth[f.index(u, v)], full[k].depth[full[k].index(u + 30, v + 20)], 0.0005 + 1e-6)
+            << "frame " << k << " pixel " << u << ", " << v;
+      }
+    }
   }
 }
 
