@@ -159,8 +159,7 @@ struct Recording {
     if (!file) throw std::runtime_error(path + ": cannot read the frame at offset " + std::to_string(r.offset));
     const oni::FrameShape shape{r.width, r.height, r.bytes_per_pixel};
     if (node.codec == oni::kCodecUncompressed) {
-      if (r.bytes != shape.bytes()) throw std::runtime_error(path + ": the frame at offset " + std::to_string(r.offset) + " changed since it was checked");
-      decoded.swap(payload);
+      decoded.swap(payload);  // the check found it the frame's size
     } else {
       const std::string why = oni::decode_frame(node.codec, payload.data(), payload.size(), shape, decoded);
       if (!why.empty()) throw std::runtime_error(path + ": offset " + std::to_string(r.offset) + ": " + why);
@@ -177,7 +176,6 @@ struct OpenNi2Source::Impl {
   std::unique_ptr<Recording> recording;
   std::vector<StampedPose> poses;
   std::size_t next = 0;  // a recording's next depth frame
-  int read = 0;          // frames given
   double first_timestamp = -1.0;
   std::chrono::steady_clock::time_point started;  // of a paced playback
 };
@@ -265,7 +263,6 @@ void OpenNi2Source::open_device() {
 void OpenNi2Source::rewind() {
   if (impl_->recording) {
     impl_->next = 0;
-    impl_->read = 0;
     impl_->first_timestamp = -1.0;
   }
 }
@@ -302,7 +299,6 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
     impl_->first_timestamp = f->timestamp;
   }
   f->timestamp -= impl_->first_timestamp;
-  ++impl_->read;
   return f;
 }
 
