@@ -131,7 +131,7 @@ Command add_perceive_command(CLI::App& app) {
   add_selection_options(*sub, opt->box, opt->rect);
   sub->add_option("--max-frames", opt->max_frames, "Stop after this many frames");
   sub->add_option("--speed", opt->speed,
-                  "Playback speed of .oni files: 1 real time, 0 fastest, -1 every frame")
+                  "Playback speed of .oni files: 1 real time (frames past due skipped), 2 twice as fast, 0 or -1 every frame")
       ->capture_default_str();
   sub->add_option("--voxel", opt->voxel, "Voxel resolution [m]")->capture_default_str();
   sub->add_option("--obb-margin", opt->obb_margin, "Augmentation of the object's OBB [m]")

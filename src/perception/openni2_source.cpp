@@ -133,8 +133,10 @@ struct Device {
       colour.stop();
     }
     // Some drivers (DummyDevice) do not join their threads on stop():
-    // destroying right away can crash (PLATFORM-NOTES).
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // destroying right away can crash (PLATFORM-NOTES). Once per device
+    // opened; 200 ms rather than the 50 ms that sufficed on an idle
+    // machine, since a loaded one can starve the driver's thread that long.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
     depth.destroy();
     colour.destroy();
     device.close();

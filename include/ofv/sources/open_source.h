@@ -28,15 +28,16 @@ namespace ofv {
  *
  * \param source the folder, file or URI.
  * \param playback_speed playback speed of a `.oni` recording
- *        (OpenNi2Options::playback_speed: 1 real time, 0 as fast as
- *        possible, -1 one frame per next()); ignored by the other sources.
+ *        (OpenNi2Options::playback_speed: 1 real time, skipping the
+ *        frames that are past due; 0 or -1 every frame, as soon as next()
+ *        asks); ignored by the other sources.
  * \param source_poses false when the camera poses come from elsewhere
  *        (RGB-D odometry): a TUM sequence without groundtruth.txt is then
  *        read with the identity for wMc (TumSequenceOptions::require_poses).
  * \throws std::invalid_argument naming `source` when it is none of the forms
  *         above (a missing `.oni` file or folder, a folder of neither kind).
  * \throws std::runtime_error from the source's constructor when a sequence is
- *         broken or OpenNI2 cannot open the file or device.
+ *         broken, a recording cannot be played or OpenNI2 cannot open the device.
  */
 std::unique_ptr<FrameSource> open_source(const std::string& source, float playback_speed, bool source_poses = true);
 
