@@ -1,5 +1,5 @@
 // libFuzzer target: the .oni structure check (ofv::check_oni_file) that
-// stands between a recording and its playback. Invalid input must throw
+// stands between a recording and its playback, and the playback. Invalid input must throw
 // std::invalid_argument; anything else is a finding.
 #include "fuzz_targets.h"
 

@@ -18,11 +18,15 @@
 #include "ofv/sources/openni2_source.h"
 #include "ofv/sources/pcd_sequence.h"
 #include "ofv/sources/sequence_files.h"
+#include "oni_player.h"  // src/perception: private to the library, played here as OpenNi2Source plays a file
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -97,12 +101,17 @@ inline void pcd_header(const std::uint8_t* data, std::size_t size) {
   }
 }
 
-/// The .oni structure check in front of a recording's playback.
+/// The .oni structure check, then the playback of what it accepted (its
+/// first 8 frames): the player refuses with std::runtime_error a recording it
+/// cannot play (no depth, a pixel format it does not read, no field of view).
 inline void oni(const std::uint8_t* data, std::size_t size) {
-  std::istringstream in(text_of(data, size));
   try {
-    check_oni_file(in, size, "fuzz.oni");
+    oni::Player player(std::make_unique<std::istringstream>(text_of(data, size)), size, "fuzz.oni", true);
+    for (std::size_t k = 0; k < std::min<std::size_t>(player.frames(), 8); ++k) {
+      (void)player.frame(k, std::nullopt);
+    }
   } catch (const std::invalid_argument&) {
+  } catch (const std::runtime_error&) {
   }
 }
 

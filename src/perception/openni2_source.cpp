@@ -1,5 +1,5 @@
 // OpenNI2 devices (OpenNI 2.2 C++ API) and .oni recordings, which ofv plays
-// itself from the record format (oni_index.h) rather than through OpenNI2's
+// itself from the record format (oni_player.h) rather than through OpenNI2's
 // player, libOniFile. That player's thread walks the device's stream list
 // without a lock while a stream is destroyed, and is still at work for a
 // while after stop(): closing the device right after stop() crashed it ten
@@ -8,16 +8,11 @@
 // checks every recording (check_oni_file) indexes it on the way.
 #include "ofv/sources/openni2_source.h"
 
-#include "oni_codecs.h"
-#include "oni_format.h"
-#include "oni_index.h"
+#include "oni_player.h"
 
 #include <OpenNI.h>
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -66,58 +61,6 @@ bool looks_like_file(const std::string& uri) {
   return uri.size() > 4 && uri.compare(uri.size() - 4, 4, ".oni") == 0;
 }
 
-/// Metres per depth unit of an OpenNI2 pixel format; 0 for a format that is no depth.
-double depth_scale(int format) {
-  return format == openni::PIXEL_FORMAT_DEPTH_1_MM ? 1e-3 : format == openni::PIXEL_FORMAT_DEPTH_100_UM ? 1e-4 : 0.0;
-}
-
-/// Pixels of an image: `width` x `height`, rows `stride` bytes apart.
-struct Image {
-  const std::uint8_t* data = nullptr;
-  int width = 0, height = 0, stride = 0;
-};
-
-/// `depth` (16-bit pixels) into `f.depth` [m]; `f.intrinsics` gives the size.
-void fill_depth(const Image& depth, double scale, RgbdFrame& f) {
-  f.depth.resize(static_cast<std::size_t>(depth.width) * static_cast<std::size_t>(depth.height));
-  for (int v = 0; v < depth.height; ++v) {
-    const std::uint8_t* row = depth.data + static_cast<std::size_t>(v) * static_cast<std::size_t>(depth.stride);
-    for (int u = 0; u < depth.width; ++u) {
-      std::uint16_t d;
-      std::memcpy(&d, row + 2 * u, 2);
-      f.depth[f.index(u, v)] = static_cast<float>(d * scale);
-    }
-  }
-}
-
-/// `colour` (RGB888) into `f.rgb` at the depth's size, nearest neighbour when the sizes differ.
-void fill_colour(const Image& colour, RgbdFrame& f) {
-  const int w = f.intrinsics.width, h = f.intrinsics.height;
-  f.rgb.resize(3 * static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  for (int v = 0; v < h; ++v) {
-    const std::uint8_t* row =
-        colour.data + static_cast<std::size_t>(v * colour.height / h) * static_cast<std::size_t>(colour.stride);
-    for (int u = 0; u < w; ++u) {
-      std::copy_n(row + 3 * (u * colour.width / w), 3, f.rgb.begin() + static_cast<std::ptrdiff_t>(3 * f.index(u, v)));
-    }
-  }
-}
-
-/// Intrinsics from fields of view [rad] over a `width` x `height` mode; the
-/// principal point at the mode's centre, less a cropping window's origin.
-CameraIntrinsics from_fov(const std::string& uri, double hfov, double vfov, int width, int height, double crop_x = 0.0,
-                          double crop_y = 0.0) {
-  CameraIntrinsics k;
-  k.fx = 0.5 * width / std::tan(0.5 * hfov);
-  k.fy = 0.5 * height / std::tan(0.5 * vfov);
-  k.cx = 0.5 * width - crop_x;
-  k.cy = 0.5 * height - crop_y;
-  if (!std::isfinite(k.fx) || !std::isfinite(k.fy) || !(k.fx > 0.0) || !(k.fy > 0.0)) {
-    throw std::runtime_error(uri + ": the depth stream reports no usable field of view; give the intrinsics");
-  }
-  return k;
-}
-
 /// A live OpenNI2 device and its streams.
 struct Device {
   openni::Device device;
@@ -143,39 +86,11 @@ struct Device {
   }
 };
 
-/// A .oni recording: its nodes, and the file its frames are read from.
-struct Recording {
-  std::ifstream file;
-  const oni::NodeIndex* depth = nullptr;
-  const oni::NodeIndex* colour = nullptr;
-  std::vector<oni::NodeIndex> nodes;
-  std::vector<std::uint8_t> payload, decoded;
-
-  /// The pixels of frame `k` of `node`, read (and decoded) into `decoded`.
-  Image frame(const std::string& path, const oni::NodeIndex& node, std::size_t k) {
-    const oni::FrameRecord& r = node.frames[k];
-    payload.resize(r.bytes);
-    file.clear();
-    file.seekg(static_cast<std::streamoff>(r.offset));
-    file.read(reinterpret_cast<char*>(payload.data()), static_cast<std::streamsize>(r.bytes));
-    if (!file) throw std::runtime_error(path + ": cannot read the frame at offset " + std::to_string(r.offset));
-    const oni::FrameShape shape{r.width, r.height, r.bytes_per_pixel};
-    if (node.codec == oni::kCodecUncompressed) {
-      decoded.swap(payload);  // the check found it the frame's size
-    } else {
-      const std::string why = oni::decode_frame(node.codec, payload.data(), payload.size(), shape, decoded);
-      if (!why.empty()) throw std::runtime_error(path + ": offset " + std::to_string(r.offset) + ": " + why);
-    }
-    return {decoded.data(), static_cast<int>(r.width), static_cast<int>(r.height),
-            static_cast<int>(r.width * r.bytes_per_pixel)};
-  }
-};
-
 }  // namespace
 
 struct OpenNi2Source::Impl {
   std::unique_ptr<Device> live;
-  std::unique_ptr<Recording> recording;
+  std::unique_ptr<oni::Player> recording;
   std::vector<StampedPose> poses;
   std::size_t next = 0;  // a recording's next depth frame
   double first_timestamp = -1.0;
@@ -198,34 +113,17 @@ void OpenNi2Source::open_recording() {
   if (!fs::is_regular_file(uri_)) {
     throw std::runtime_error(uri_ + ": no such .oni file");
   }
-  auto rec = std::make_unique<Recording>();
-  rec->file.open(uri_, std::ios::binary);
+  auto file = std::make_unique<std::ifstream>(uri_, std::ios::binary);
   std::error_code ec;
   const std::uint64_t size = fs::file_size(uri_, ec);
-  if (!rec->file || ec) throw std::runtime_error(uri_ + ": cannot read the .oni file");
-  rec->nodes = oni::index_oni_file(rec->file, size, uri_);  // never plays a malformed record
-  for (const oni::NodeIndex& n : rec->nodes) {
-    if (n.type == oni::kNodeTypeDepth && rec->depth == nullptr) rec->depth = &n;
-    if (n.type == oni::kNodeTypeImage && rec->colour == nullptr && options_.colour && !n.frames.empty()) rec->colour = &n;
-  }
-  if (rec->depth == nullptr) throw std::runtime_error(uri_ + ": no depth stream");
-  for (const oni::NodeIndex* n : {rec->depth, rec->colour}) {
-    if (n == nullptr) continue;
-    for (const oni::FrameRecord& r : n->frames) {
-      const bool ok = n == rec->depth ? depth_scale(static_cast<int>(r.pixel_format)) != 0.0
-                                      : r.pixel_format == static_cast<std::uint64_t>(openni::PIXEL_FORMAT_RGB888);
-      if (!ok) {
-        throw std::runtime_error(uri_ + ": unsupported " + (n == rec->depth ? "depth" : "colour") + " pixel format " +
-                                 std::to_string(r.pixel_format));
-      }
-    }
-  }
+  if (!*file || ec) throw std::runtime_error(uri_ + ": cannot read the .oni file");
+  auto rec = std::make_unique<oni::Player>(std::move(file), size, uri_, options_.colour);  // never plays a malformed record
   const std::string poses = uri_ + ".poses.txt";
   if (fs::exists(poses)) {
     impl_->poses = read_pose_file(poses);
-    if (impl_->poses.size() < rec->depth->frames.size()) {
+    if (impl_->poses.size() < rec->frames()) {
       throw std::invalid_argument(poses + ": " + std::to_string(impl_->poses.size()) + " poses for " +
-                                  std::to_string(rec->depth->frames.size()) + " frames");
+                                  std::to_string(rec->frames()) + " frames");
     }
   }
   impl_->recording = std::move(rec);
@@ -272,7 +170,7 @@ void OpenNi2Source::rewind() {
 bool OpenNi2Source::is_file() const { return impl_->recording != nullptr; }
 
 int OpenNi2Source::number_of_frames() const {
-  return impl_->recording ? static_cast<int>(impl_->recording->depth->frames.size()) : 0;
+  return impl_->recording ? static_cast<int>(impl_->recording->frames()) : 0;
 }
 
 std::string OpenNi2Source::describe() const {
@@ -306,9 +204,8 @@ std::optional<RgbdFrame> OpenNi2Source::next() {
 
 std::optional<RgbdFrame> OpenNi2Source::next_recorded() {
   Impl& s = *impl_;
-  Recording& rec = *s.recording;
-  const std::vector<oni::FrameRecord>& frames = rec.depth->frames;
-  if (s.next >= frames.size()) {
+  oni::Player& rec = *s.recording;
+  if (s.next >= rec.frames()) {
     return std::nullopt;
   }
   if (options_.playback_speed > 0.0f) {
@@ -316,42 +213,16 @@ std::optional<RgbdFrame> OpenNi2Source::next_recorded() {
     // speed after the first; frames already past due give way to the last
     // one due, as a live stream's would to a consumer that fell behind.
     const auto due = [&](std::size_t k) {
-      const double after = static_cast<double>(frames[k].time_us - frames.front().time_us) * 1e-6 / options_.playback_speed;
+      const double after = static_cast<double>(rec.time_us(k) - rec.time_us(0)) * 1e-6 / options_.playback_speed;
       return s.started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(after));
     };
     if (s.next == 0) s.started = std::chrono::steady_clock::now();
     const auto now = std::chrono::steady_clock::now();
-    while (s.next + 1 < frames.size() && due(s.next + 1) <= now) ++s.next;
+    while (s.next + 1 < rec.frames() && due(s.next + 1) <= now) ++s.next;
     std::this_thread::sleep_until(due(s.next));
   }
   const std::size_t k = s.next++;
-  const oni::FrameRecord& r = frames[k];
-  RgbdFrame f;
-  if (options_.intrinsics) {
-    f.intrinsics = *options_.intrinsics;
-    if (static_cast<std::uint64_t>(f.intrinsics.width) != r.width ||
-        static_cast<std::uint64_t>(f.intrinsics.height) != r.height) {
-      throw BadFrame(uri_ + ": a frame is " + std::to_string(r.width) + "x" + std::to_string(r.height) +
-                     ", the given intrinsics " + std::to_string(f.intrinsics.width) + "x" +
-                     std::to_string(f.intrinsics.height));
-    }
-  } else {
-    f.intrinsics = from_fov(uri_, rec.depth->hfov, rec.depth->vfov, static_cast<int>(r.mode_width),
-                            static_cast<int>(r.mode_height), static_cast<double>(r.crop_x), static_cast<double>(r.crop_y));
-    f.intrinsics.width = static_cast<int>(r.width);
-    f.intrinsics.height = static_cast<int>(r.height);
-  }
-  f.timestamp = static_cast<double>(r.time_us) * 1e-6;
-  fill_depth(rec.frame(uri_, *rec.depth, k), depth_scale(static_cast<int>(r.pixel_format)), f);
-  if (rec.colour != nullptr) {
-    // The colour frame nearest in time (the earlier of two as near).
-    const std::vector<oni::FrameRecord>& c = rec.colour->frames;
-    const auto after = std::lower_bound(c.begin(), c.end(), r.time_us,
-                                        [](const oni::FrameRecord& x, std::uint64_t t) { return x.time_us < t; });
-    std::size_t j = static_cast<std::size_t>(after - c.begin());
-    if (j == c.size() || (j > 0 && r.time_us - c[j - 1].time_us <= c[j].time_us - r.time_us)) --j;
-    fill_colour(rec.frame(uri_, *rec.colour, j), f);
-  }
+  RgbdFrame f = rec.frame(k, options_.intrinsics);
   if (!s.poses.empty()) {
     f.wMc = s.poses[k].wMc;  // frame k of a recording made by OniWriter has pose line k
   }
@@ -365,14 +236,14 @@ std::optional<RgbdFrame> OpenNi2Source::next_live() {
     throw std::runtime_error(uri_ + ": no depth frame within " +
                              std::to_string(options_.timeout_ms) + " ms: " + last_error());
   }
-  const double scale = depth_scale(depth.getVideoMode().getPixelFormat());
+  const double scale = oni::depth_scale(depth.getVideoMode().getPixelFormat());
   if (scale == 0.0) {
     const std::string why = uri_ + ": unsupported depth pixel format " +
                             std::to_string(static_cast<int>(depth.getVideoMode().getPixelFormat()));
     // A stream set to depth that hands over another format has had a glitch
     // (OpenNI2's DummyDevice once gave its depth stream a colour frame on a
     // loaded machine): that frame is bad, not the device.
-    if (depth_scale(s.depth.getVideoMode().getPixelFormat()) != 0.0) throw BadFrame(why);
+    if (oni::depth_scale(s.depth.getVideoMode().getPixelFormat()) != 0.0) throw BadFrame(why);
     throw std::runtime_error(why);
   }
   const int w = depth.getWidth();
@@ -387,9 +258,7 @@ std::optional<RgbdFrame> OpenNi2Source::next_live() {
                                std::to_string(f.intrinsics.height));
     }
   } else {
-    f.intrinsics = from_fov(uri_, s.depth.getHorizontalFieldOfView(), s.depth.getVerticalFieldOfView(), w, h);
-    f.intrinsics.width = w;
-    f.intrinsics.height = h;
+    f.intrinsics = oni::intrinsics_from_fov(uri_, s.depth.getHorizontalFieldOfView(), s.depth.getVerticalFieldOfView(), w, h);
   }
   f.timestamp = static_cast<double>(depth.getTimestamp()) * 1e-6;
   if (depth.getData() == nullptr || depth.getStrideInBytes() < static_cast<int>(w * sizeof(openni::DepthPixel)) ||
@@ -397,7 +266,7 @@ std::optional<RgbdFrame> OpenNi2Source::next_live() {
     throw BadFrame(uri_ + ": a depth frame of " + std::to_string(depth.getDataSize()) + " bytes for " +
                    std::to_string(w) + "x" + std::to_string(h) + " pixels (a short read)");
   }
-  fill_depth({static_cast<const std::uint8_t*>(depth.getData()), w, h, depth.getStrideInBytes()}, scale, f);
+  oni::fill_depth({static_cast<const std::uint8_t*>(depth.getData()), w, h, depth.getStrideInBytes()}, scale, f);
   if (s.has_colour) {
     openni::VideoFrameRef colour;
     if (!read_frame(s.colour, colour, options_.timeout_ms)) {
@@ -415,7 +284,7 @@ std::optional<RgbdFrame> OpenNi2Source::next_live() {
       throw BadFrame(uri_ + ": a colour frame of " + std::to_string(colour.getDataSize()) + " bytes for " +
                      std::to_string(cw) + "x" + std::to_string(ch) + " pixels (a short read)");
     }
-    fill_colour({static_cast<const std::uint8_t*>(colour.getData()), cw, ch, colour.getStrideInBytes()}, f);
+    oni::fill_colour({static_cast<const std::uint8_t*>(colour.getData()), cw, ch, colour.getStrideInBytes()}, f);
   }
   return f;
 }
