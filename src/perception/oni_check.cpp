@@ -18,6 +18,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <set>
 #include <stdexcept>
 #include <vector>
@@ -121,12 +122,18 @@ std::uint64_t bytes_per_pixel(std::uint64_t format) {
 
 }  // namespace
 
-void check_oni_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+std::unique_ptr<std::istream> oni::open_oni_file(const std::string& path, std::uint64_t& size) {
+  auto in = std::make_unique<std::ifstream>(path, std::ios::binary);
   std::error_code ec;
-  const std::uint64_t size = std::filesystem::file_size(path, ec);
-  if (!in || ec) throw std::invalid_argument(path + ": cannot read the .oni file");
-  check_oni_file(in, size, path);
+  size = std::filesystem::file_size(path, ec);
+  if (!*in || ec) throw std::invalid_argument(path + ": cannot read the .oni file");
+  return in;
+}
+
+void check_oni_file(const std::string& path) {
+  std::uint64_t size = 0;
+  const std::unique_ptr<std::istream> in = oni::open_oni_file(path, size);  // sets size first
+  check_oni_file(*in, size, path);
 }
 
 void check_oni_file(std::istream& in, std::uint64_t size, const std::string& path) {

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <istream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,5 +37,9 @@ struct NodeIndex {
 /// \brief check_oni_file() and what it learned: the nodes in the order they were added.
 /// \throws std::invalid_argument as check_oni_file().
 std::vector<NodeIndex> index_oni_file(std::istream& in, std::uint64_t size, const std::string& path);
+
+/// \brief The file `path`, open for reading, and its size in `size`.
+/// \throws std::invalid_argument "PATH: cannot read the .oni file".
+std::unique_ptr<std::istream> open_oni_file(const std::string& path, std::uint64_t& size);
 
 }  // namespace ofv::oni

@@ -14,7 +14,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -113,10 +112,8 @@ void OpenNi2Source::open_recording() {
   if (!fs::is_regular_file(uri_)) {
     throw std::runtime_error(uri_ + ": no such .oni file");
   }
-  auto file = std::make_unique<std::ifstream>(uri_, std::ios::binary);
-  std::error_code ec;
-  const std::uint64_t size = fs::file_size(uri_, ec);
-  if (!*file || ec) throw std::runtime_error(uri_ + ": cannot read the .oni file");
+  std::uint64_t size = 0;
+  std::unique_ptr<std::istream> file = oni::open_oni_file(uri_, size);
   auto rec = std::make_unique<oni::Player>(std::move(file), size, uri_, options_.colour);  // never plays a malformed record
   const std::string poses = uri_ + ".poses.txt";
   if (fs::exists(poses)) {

@@ -432,11 +432,7 @@ std::vector<RgbdFrame> played(const std::string& path) {
     EXPECT_EQ(frames[0].intrinsics.height, theirs.height) << path;
   }
   for (std::size_t k = 0; k < std::min(frames.size(), theirs.depth.size()); ++k) {
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < frames[k].depth.size(); ++i) {
-      differ += frames[k].depth[i] == static_cast<float>(theirs.depth[k][i] * 1e-3) ? 0 : 1;
-    }
-    EXPECT_EQ(differ, 0u) << path << ": depth frame " << k << " is not OpenNI2's";
+    EXPECT_EQ(test::depth_differences(frames[k].depth, theirs.depth[k]), 0u) << path << ": depth frame " << k << " is not OpenNI2's";
     if (!theirs.rgb.empty()) {
       EXPECT_EQ(frames[k].rgb, theirs.rgb[k]) << path << ": colour frame " << k << " is not OpenNI2's";
     }

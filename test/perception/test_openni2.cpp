@@ -96,11 +96,7 @@ TEST(OpenNi2, OfvPlaysARecordingAsOpenNi2sOwnPlayerDoes) {
     EXPECT_NEAR(f->intrinsics.fx, 0.5 * theirs.width / std::tan(0.5 * theirs.hfov), 1e-3);
     EXPECT_NEAR(f->intrinsics.fy, 0.5 * theirs.height / std::tan(0.5 * theirs.vfov), 1e-3);
     EXPECT_NEAR(f->timestamp, static_cast<double>(theirs.time_us[k] - theirs.time_us[0]) * 1e-6, 1e-9);
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < f->depth.size(); ++i) {
-      differ += f->depth[i] == static_cast<float>(theirs.depth[k][i] * 1e-3) ? 0 : 1;
-    }
-    EXPECT_EQ(differ, 0u) << "frame " << k;
+    EXPECT_EQ(test::depth_differences(f->depth, theirs.depth[k]), 0u) << "frame " << k;
     EXPECT_EQ(f->rgb, theirs.rgb[k]) << "frame " << k;
   }
 }
