@@ -73,12 +73,17 @@ Eigen::Vector3d normal_of(const TriangleMesh& m, std::size_t t) {
   return (m.vertices[v[1]].cast<double>() - a).cross(m.vertices[v[2]].cast<double>() - a).normalized();
 }
 
-// Sample s of m, its triangle's normal given.
-WorldPoint at(const TriangleMesh& m, const SurfaceSample& s, const Eigen::Vector3d& normal) {
+// Where sample s of m lies.
+Eigen::Vector3d position_of(const TriangleMesh& m, const SurfaceSample& s) {
   const auto& t = m.triangles[static_cast<std::size_t>(s.triangle)];
   const Eigen::Vector3d a = m.vertices[t[0]].cast<double>(), b = m.vertices[t[1]].cast<double>(),
                         c = m.vertices[t[2]].cast<double>();
-  return {(1.0 - s.u - s.v) * a + s.u * b + s.v * c, normal};
+  return (1.0 - s.u - s.v) * a + s.u * b + s.v * c;
+}
+
+// Sample s of m, its triangle's normal given.
+WorldPoint at(const TriangleMesh& m, const SurfaceSample& s, const Eigen::Vector3d& normal) {
+  return {position_of(m, s), normal};
 }
 
 WorldPoint at(const TriangleMesh& m, const SurfaceSample& s) {
@@ -634,7 +639,7 @@ Eigen::Vector3d Renderer::object_centroid() const {
   const TriangleMesh& m = impl_->world[static_cast<std::size_t>(impl_->object)];
   const auto& samples = impl_->samples[static_cast<std::size_t>(impl_->object)];
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const auto& s : samples) sum += at(m, s).p;
+  for (const auto& s : samples) sum += position_of(m, s);
   return sum / static_cast<double>(samples.size());
 }
 
@@ -697,7 +702,7 @@ ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double 
   const std::size_t obj = static_cast<std::size_t>(impl_->object);
   Eigen::Matrix3Xd all(3, static_cast<Eigen::Index>(impl_->samples[obj].size()));
   Eigen::Index n = 0;
-  for (const auto& s : impl_->samples[obj]) all.col(n++) = at(impl_->world[obj], s).p;
+  for (const auto& s : impl_->samples[obj]) all.col(n++) = position_of(impl_->world[obj], s);
   const Eigen::Vector3d mean = all.rowwise().mean();
   const Eigen::Matrix3Xd centred = all.colwise() - mean;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred * centred.transpose());
