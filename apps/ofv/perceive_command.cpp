@@ -226,8 +226,8 @@ Command add_perceive_command(CLI::App& app) {
               std::vector<double> odometry_ms;
               if (use_odometry) {
                 pose_source = [&statuses, &odometry_ms, steps = odometry::odometry_pose_source(odometry_settings)](
-                                  const RgbdFrame& frame, std::optional<double> object_depth) {
-                  perception::FramePose pose = steps(frame, object_depth);
+                                  const RgbdFrame& frame, const ObjectHint& object) {
+                  perception::FramePose pose = steps(frame, object);
                   ++statuses[pose.status];
                   for (const auto& [name, value] : pose.diagnostics) {
                     if (name == "ms") odometry_ms.push_back(value);
@@ -266,7 +266,8 @@ Command add_perceive_command(CLI::App& app) {
                 text << "ofv perceive: odometry " << odometry::to_string(odometry_settings.method) << ": median "
                      << (odometry_ms.empty() ? 0.0 : odometry_ms[odometry_ms.size() / 2]) << " ms/frame;";
                 for (const auto status : {odometry::OdometryStatus::Ok, odometry::OdometryStatus::FirstFrame,
-                                          odometry::OdometryStatus::Failed, odometry::OdometryStatus::Implausible}) {
+                                          odometry::OdometryStatus::Failed, odometry::OdometryStatus::Implausible,
+                                          odometry::OdometryStatus::Degenerate}) {
                   const auto n = statuses.find(odometry::to_string(status));
                   if (n != statuses.end()) text << ' ' << n->first << ' ' << n->second;
                 }

@@ -107,7 +107,7 @@ class CommandLines {
 
   /// One JSON line per command: frame, time, status, twist (17 digits),
   /// safety action, with a pose source its word for the frame's pose (ok,
-  /// first_frame, failed, implausible), the loop's mode, the guard that moved it and the
+  /// first_frame, failed, implausible, degenerate), the loop's mode, the guard that moved it and the
   /// proposer of the target, the confirmed occluder tracks seen in the frame
   /// (id, position [m], velocity [m/s], velocity standard deviation per axis [m/s]).
   void print(long frame, double t, const char* status, const vpColVector& v, const char* safety,

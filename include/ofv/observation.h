@@ -24,8 +24,8 @@ namespace ofv {
 /// \brief Whether the loop knows the camera pose of a frame (Observation::pose).
 enum class PoseStatus {
   Known,    ///< the frame's own pose (robot, recording, simulator) or one a pose source estimated
-  /// The pose source could not tell it (RGB-D odometry failed or found an
-  /// implausible motion): `wMc` is its last good pose. The loop commands
+  /// The pose source could not tell it (RGB-D odometry failed, found an
+  /// implausible motion or a scene that cannot fix it): `wMc` is its last good pose. The loop commands
   /// zero velocity for the frame (ofv::servo::SafetyAction::PoseUnknown).
   Unknown,
 };

@@ -38,25 +38,41 @@ struct FramePose {
 };
 
 /**
+ * \brief What the front end found of the object in the previous frame, for a
+ *        pose source: its supervoxels' centroids in that frame's camera.
+ *        Odometry leaves out what is nearer than the object (hands) and tells
+ *        whether the scene apart from the object fixes the camera's motion.
+ */
+struct ObjectHint {
+  /// [m], 3 x N; empty before the object is found or when it was lost.
+  Eigen::Matrix3Xd points_c = Eigen::Matrix3Xd(3, 0);
+
+  /// \brief The nearest depth (the smallest Z) [m]; none without points.
+  [[nodiscard]] std::optional<double> nearest_depth() const {
+    if (points_c.cols() == 0) return std::nullopt;
+    return points_c.row(2).minCoeff();
+  }
+};
+
+/**
+ * \brief The hint of world points seen from a camera (the object's
+ *        supervoxels, seen from the pose the front end used).
+ * \param points_w points in the world frame [m], 3 x N.
+ * \param wMc      the camera's pose (world <- camera).
+ */
+[[nodiscard]] inline ObjectHint object_hint(const Eigen::Matrix3Xd& points_w, const Eigen::Isometry3d& wMc) {
+  ObjectHint hint;
+  if (points_w.cols() > 0) hint.points_c = wMc.inverse() * points_w;
+  return hint;
+}
+
+/**
  * \brief Gives a frame's camera pose before the front end runs. Called once
  *        per frame, in order, with the frame as the source read it (its own
  *        `wMc`: the robot's, the recording's or the simulator's) and the
- *        object's nearest depth in the previous frame's camera [m] (none
- *        before the object is found or when it was lost; nearest_depth()).
+ *        object as the front end found it in the previous frame (empty
+ *        before the object is found or when it was lost; object_hint()).
  */
-using PoseSource = std::function<FramePose(const RgbdFrame& frame, std::optional<double> object_depth)>;
-
-/**
- * \brief The nearest depth of world points in a camera (what a pose source
- *        is given as `object_depth`: the object's supervoxels, seen from the
- *        pose the front end used).
- * \param points_w points in the world frame [m], 3 x N.
- * \param wMc      the camera's pose (world <- camera).
- * \return the smallest Z in the camera frame [m]; none without points.
- */
-[[nodiscard]] inline std::optional<double> nearest_depth(const Eigen::Matrix3Xd& points_w, const Eigen::Isometry3d& wMc) {
-  if (points_w.cols() == 0) return std::nullopt;
-  return (wMc.inverse() * points_w).row(2).minCoeff();
-}
+using PoseSource = std::function<FramePose(const RgbdFrame& frame, const ObjectHint& object)>;
 
 }  // namespace ofv

@@ -144,7 +144,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
   BadFrameBudget bad_frames(options.max_bad_frames_in_row, options.max_bad_frames_per_minute);
   try {
     std::optional<double> first_stamp, last_stamp;
-    std::optional<double> object_depth;  // for the pose source: the object's nearest depth in the last frame
+    ObjectHint object;  // for the pose source: the object in the last frame
     while (options.stop == nullptr || *options.stop == 0) {
       const auto asked = Clock::now();
       std::optional<RgbdFrame> frame;
@@ -186,7 +186,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
           if (options.pose_source) {
             // The observer sees the frame with the source's pose; the frame
             // keeps its own (the robot's, the recording's) for on_frame.
-            pose = options.pose_source(*frame, object_depth);
+            pose = options.pose_source(*frame, object);
             const Eigen::Isometry3d own = frame->wMc;
             frame->wMc = pose->wMc;
             struct Restore {
@@ -224,7 +224,7 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       observation.wMc = pose ? pose->wMc : frame->wMc;
       observation.pose = !pose || pose->ok ? PoseStatus::Known : PoseStatus::Unknown;
       out.pose = pose ? &*pose : nullptr;
-      object_depth = observation.problem ? nearest_depth(observation.problem->positions, observation.wMc) : std::nullopt;
+      object = observation.problem ? object_hint(observation.problem->positions, observation.wMc) : ObjectHint{};
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       observation.age = out.frame_age = options.wall_clock_age ? out.perception_s : gap;
       out.observation = &observation;

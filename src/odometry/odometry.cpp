@@ -1,6 +1,7 @@
 // RGB-D odometry on OpenCV's rgbd module (ofv/odometry/odometry.h).
 #include "ofv/odometry/odometry.h"
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rgbd.hpp>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -22,6 +24,13 @@ constexpr double kDegree = M_PI / 180.0;
 // Pixel step of the inlier count: 1/16 of the pixels give the fraction
 // within a percent at a tenth of the cost of the odometry itself.
 constexpr int kInlierStride = 4;
+// The still scene's patches: kPatch x kPatch pixels as matched, at least
+// kPatchUsed of them used and away from the object, flat (the least spread
+// of their points at most kFlat of the next); fewer than kMinPatches: no constraint.
+constexpr int kPatch = 8;
+constexpr int kPatchUsed = 48;
+constexpr double kFlat = 0.05;
+constexpr int kMinPatches = 8;
 
 cv::Ptr<cv::rgbd::Odometry> make_odometry(const OdometrySettings& s, const CameraIntrinsics& k) {
   cv::Mat K = (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
@@ -113,13 +122,14 @@ struct Odometry::Impl {
 
   /// The frame as OpenCV takes it: depth [m] with NaN where missing, the
   /// mask of the pixels used, grey image for the photometric methods.
-  cv::Ptr<cv::rgbd::OdometryFrame> convert(const RgbdFrame& frame, std::optional<double> object_depth,
+  cv::Ptr<cv::rgbd::OdometryFrame> convert(const RgbdFrame& frame, const ObjectHint& object,
                                            OdometryDiagnostics& d) const {
     const int w = intrinsics.width;
     const int h = intrinsics.height;
     cv::Mat depth(h, w, CV_32FC1);
     cv::Mat mask(h, w, CV_8UC1);
     const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::optional<double> object_depth = object.nearest_depth();
     const bool masking = settings.mask && object_depth && std::isfinite(*object_depth);
     const double nearest = masking ? *object_depth - settings.mask_margin : 0.0;
     long used = 0;
@@ -154,6 +164,56 @@ struct Odometry::Impl {
       }
     }
     return cv::rgbd::OdometryFrame::create(grey, depth, mask);
+  }
+
+  /// OdometryDiagnostics::still_constraint of a frame as matched: the
+  /// normals of its flat patches of used pixels farther than object_radius
+  /// from the object's points (discs around their projections).
+  [[nodiscard]] double still_constraint(const cv::rgbd::OdometryFrame& f, const ObjectHint& object) const {
+    const CameraIntrinsics& k = intrinsics;
+    cv::Mat away = f.mask.clone();
+    for (Eigen::Index i = 0; i < object.points_c.cols(); ++i) {
+      const Eigen::Vector3d p = object.points_c.col(i);
+      if (!(p.z() > 1e-6) || !p.allFinite()) continue;
+      const double u = k.fx * p.x() / p.z() + k.cx, v = k.fy * p.y() / p.z() + k.cy;
+      const double r = k.fx * settings.object_radius / p.z();
+      if (u < -r || v < -r || u > k.width + r || v > k.height + r) continue;
+      cv::circle(away, cv::Point(static_cast<int>(std::lround(u)), static_cast<int>(std::lround(v))),
+                 static_cast<int>(std::ceil(r)), cv::Scalar(0), cv::FILLED);
+    }
+
+    Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();
+    int patches = 0;
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(kPatch * kPatch);
+    for (int v0 = 0; v0 + kPatch <= k.height; v0 += kPatch) {
+      for (int u0 = 0; u0 + kPatch <= k.width; u0 += kPatch) {
+        points.clear();
+        for (int v = v0; v < v0 + kPatch; ++v) {
+          const auto* zrow = f.depth.ptr<float>(v);
+          const auto* arow = away.ptr<std::uint8_t>(v);
+          for (int u = u0; u < u0 + kPatch; ++u) {
+            if (arow[u] == 0) continue;
+            const double z = zrow[u];
+            points.emplace_back((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z);
+          }
+        }
+        if (static_cast<int>(points.size()) < kPatchUsed) continue;
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3d& p : points) mean += p;
+        mean /= static_cast<double>(points.size());
+        Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+        for (const Eigen::Vector3d& p : points) spread += (p - mean) * (p - mean).transpose();
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> patch(spread);
+        if (patch.eigenvalues()(0) > kFlat * patch.eigenvalues()(1)) continue;  // an edge, a corner, a curve
+        const Eigen::Vector3d n = patch.eigenvectors().col(0);
+        normals += n * n.transpose();
+        ++patches;
+      }
+    }
+    if (patches < kMinPatches) return 0.0;
+    return std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normals / patches, Eigen::EigenvaluesOnly)
+                             .eigenvalues()(0));
   }
 
   /// Of the used pixels of `src` (sampled) whose point, moved by `motion`
@@ -219,7 +279,7 @@ void Odometry::reset() {
 const Eigen::Isometry3d& Odometry::wMc() const { return impl_->wMc; }
 const OdometrySettings& Odometry::settings() const { return impl_->settings; }
 
-OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> object_depth) {
+OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) {
   const auto start = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   const CameraIntrinsics& k = frame.intrinsics;
@@ -247,7 +307,7 @@ OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> obje
     m.intrinsics = reduced(k, m.factor);
     m.odometry = make_odometry(m.settings, m.intrinsics);
   }
-  cv::Ptr<cv::rgbd::OdometryFrame> current = m.convert(frame, object_depth, d);
+  cv::Ptr<cv::rgbd::OdometryFrame> current = m.convert(frame, object, d);
   if (!m.started) {
     // The first frame is a reference only if it can be one; until then
     // every frame is a first frame, at the source's pose.
@@ -261,6 +321,13 @@ OdometryResult Odometry::step(const RgbdFrame& frame, std::optional<double> obje
     return finish(OdometryStatus::FirstFrame);
   }
   if (d.valid_fraction < m.settings.min_valid_fraction) return finish(OdometryStatus::Failed);
+
+  // What the scene cannot fix is not matched (and before OpenCV's
+  // compute(), which changes the frame's mask).
+  if (m.settings.min_still_constraint > 0.0 && object.points_c.cols() > 0) {
+    d.still_constraint = m.still_constraint(*current, object);
+    if (d.still_constraint < m.settings.min_still_constraint) return finish(OdometryStatus::Degenerate);
+  }
 
   // The last motion as the first guess: the camera moves smoothly.
   cv::Mat init(4, 4, CV_64FC1);
@@ -346,6 +413,8 @@ const char* to_string(OdometryStatus status) {
       return "failed";
     case OdometryStatus::Implausible:
       return "implausible";
+    case OdometryStatus::Degenerate:
+      return "degenerate";
   }
   return "?";
 }
@@ -367,7 +436,7 @@ FramePose frame_pose(const OdometryResult& r) {
   const OdometryDiagnostics& d = r.diagnostics;
   pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
                       {"overlap_fraction", d.overlap_fraction}, {"inlier_fraction", d.inlier_fraction},
-                      {"residual_m", d.residual},
+                      {"residual_m", d.residual},             {"still_constraint", d.still_constraint},
                       {"translation_m", d.translation},       {"rotation_deg", d.rotation},
                       {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
   return pose;
@@ -376,8 +445,8 @@ FramePose frame_pose(const OdometryResult& r) {
 PoseSource odometry_pose_source(const OdometrySettings& settings) {
   // Shared: std::function copies the callable, and every copy is one sequence.
   auto odometry = std::make_shared<Odometry>(settings);
-  return [odometry](const RgbdFrame& frame, std::optional<double> object_depth) {
-    return frame_pose(odometry->step(frame, object_depth));
+  return [odometry](const RgbdFrame& frame, const ObjectHint& object) {
+    return frame_pose(odometry->step(frame, object));
   };
 }
 

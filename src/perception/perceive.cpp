@@ -29,7 +29,7 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
   double sum[kScores] = {};
   long count[kScores] = {};
   BadFrameBudget bad_frames(kMaxBadFramesInRow, kMaxBadFramesPerMinute);
-  std::optional<double> object_depth;  // the object's nearest depth in the last perceived frame's camera
+  ObjectHint object;  // the object in the last perceived frame's camera
   while (max_frames < 0 || summary.frames < max_frames) {
     PerceivedFrame f;
     // A frame the source cannot read (BadFrame) or the front end refuses is
@@ -46,7 +46,7 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     if (bad.empty()) {
       f.source_wMc = f.frame.wMc;
       if (pose_source) {
-        f.pose = pose_source(f.frame, object_depth);
+        f.pose = pose_source(f.frame, object);
         f.frame.wMc = f.pose->wMc;
       }
     }
@@ -63,8 +63,7 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     }
     bad_frames.good();
     f.index = summary.frames;
-    object_depth.reset();
-    if (f.result.status != TrackingStatus::Lost) object_depth = nearest_depth(f.result.problem.positions, f.frame.wMc);
+    object = f.result.status != TrackingStatus::Lost ? object_hint(f.result.problem.positions, f.frame.wMc) : ObjectHint{};
     front_end_ms.push_back(f.result.timings.total);
     if (f.result.status != TrackingStatus::Lost) {
       f.result.problem.previous_view = previous_view;

@@ -423,8 +423,8 @@ TEST(RobotLoop, APoseSourceGivesThePoseAndAFrameWithoutOneStopsTheRobot) {
   servo::RobotLoopOptions options;
   std::vector<std::optional<double>> depths;
   int calls = 0;
-  options.pose_source = [&](const RgbdFrame& frame, std::optional<double> object_depth) {
-    depths.push_back(object_depth);
+  options.pose_source = [&](const RgbdFrame& frame, const ObjectHint& object) {
+    depths.push_back(object.nearest_depth());
     EXPECT_TRUE(frame.wMc.isApprox(Eigen::Isometry3d::Identity()));  // the frame's own
     FramePose pose;
     pose.wMc = Eigen::Translation3d(0.0, 0.0, 0.01 * std::min(calls, 2)) * Eigen::Isometry3d::Identity();

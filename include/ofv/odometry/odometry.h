@@ -10,12 +10,15 @@
  * A frame with too few usable pixels (Failed), or a step OpenCV reports
  * failed or whose motion is not finite, too large
  * (OdometrySettings::max_translation, max_rotation) or matched by too few
- * pixels (Implausible), is a status: the pose stays the last good one.
+ * pixels (Implausible), is a status: the pose stays the last good one. So
+ * is a step where what is still apart from the object does not fix the
+ * camera's translation (Degenerate): there the motion found may be the
+ * object's, and the pose is not the world's.
  *
  * \code
  * ofv::odometry::Odometry odometry;  // ICPOdometry against a keyframe (or: odometry_pose_source())
  * while (auto frame = source->next()) {
- *   const ofv::odometry::OdometryResult r = odometry.step(*frame);
+ *   const ofv::odometry::OdometryResult r = odometry.step(*frame);  // or step(*frame, object_hint(...))
  *   if (r.status == ofv::odometry::OdometryStatus::Ok) frame->wMc = r.wMc;
  * }
  * \endcode
@@ -28,8 +31,8 @@
 
 #include <Eigen/Geometry>
 
+#include <limits>
 #include <memory>
-#include <optional>
 #include <string>
 
 namespace ofv::odometry {
@@ -56,6 +59,15 @@ enum class OdometryStatus {
   /// (OdometryDiagnostics::overlap_fraction below min_overlap_fraction) or too
   /// few of those match (min_inlier_fraction). The pose is the last good one.
   Implausible,
+  /// The scene apart from the object (the used pixels farther than
+  /// OdometrySettings::object_radius from the object's supervoxels in the
+  /// previous frame) leaves a direction of the camera's translation free
+  /// (OdometryDiagnostics::still_constraint below min_still_constraint): a
+  /// bare table beside the object fixes only the depth. A motion found
+  /// would then be the object's as much as the camera's (the object is what
+  /// holds the match), so none is sought: the pose stays the last good one,
+  /// as for Implausible. Checked only with an object given, before the match.
+  Degenerate,
 };
 
 /**
@@ -97,6 +109,17 @@ struct OdometrySettings {
   int max_width = 320;
   bool mask = true;  ///< leave out pixels nearer than the object's depth minus mask_margin, when the caller gives it
   double mask_margin = 0.10;  ///< [m] see `mask`: the hands and occluders in front of the object
+  /// A step is Degenerate when the still scene fixes the camera's
+  /// translation less than this (OdometryDiagnostics::still_constraint; 0:
+  /// never). On the simulator's scenes (docs/perception.md): the table
+  /// within the sensor's range beside a case or a cloth, or an arm over the
+  /// view, 1e-5 and less; the case's holding hand or a cage 1.4e-3 and more.
+  double min_still_constraint = 2e-4;
+  /// [m] pixels within this of one of the object's supervoxel centroids
+  /// (the previous frame's, ObjectHint) are the object's: they do not count
+  /// as still scene (3/4 of R_seed, about a supervoxel's reach from its
+  /// centroid: twice as much covered the DVD case's holder too).
+  double object_radius = 0.015;
 };
 
 /// \brief The numbers behind a step's status.
@@ -109,6 +132,13 @@ struct OdometryDiagnostics {
   double overlap_fraction = 0.0;
   double inlier_fraction = 0.0;  ///< of the overlap, the pixels matching the reference within max_depth_diff
   double residual = 0.0;         ///< RMS depth difference of the matching pixels [m]
+  /// How well the still scene fixes the camera's translation: the smallest
+  /// eigenvalue of the mean n n^T of the normals of the flat 8 x 8 pixel
+  /// patches (as matched) of the used pixels away from the object, 0 to 1
+  /// (1/3 for patches facing every way alike; 0 when all are parallel or
+  /// fewer than 8 patches are left). NaN when not measured (no object given,
+  /// min_still_constraint 0, the first frame or one that failed).
+  double still_constraint = std::numeric_limits<double>::quiet_NaN();
   double translation = 0.0;      ///< the step's motion from the previous pose [m] (as found, even when rejected)
   double rotation = 0.0;         ///< the step's rotation from the previous pose [deg]
   bool converged = false;        ///< OpenCV's compute() found a motion
@@ -148,13 +178,15 @@ class Odometry {
    * \brief One frame: its pose from the motion since the reference frame.
    * \param frame        depth [m] (colour for the `rgbd` methods), intrinsics; its
    *                     wMc is read only on the first frame (the start pose).
-   * \param object_depth the object's nearest depth in the previous frame's camera [m]:
-   *                     with OdometrySettings::mask, pixels nearer than it minus
-   *                     mask_margin are left out (hands, occluders). None: no mask.
+   * \param object       the object's supervoxels in the previous frame's camera:
+   *                     with OdometrySettings::mask, pixels nearer than the nearest
+   *                     minus mask_margin are left out (hands, occluders); the
+   *                     rest of the scene away from them must fix the motion
+   *                     (Degenerate). Empty: no mask, no such check.
    * \throws std::invalid_argument when the frame's buffers disagree with its
    *         intrinsics or the intrinsics change.
    */
-  OdometryResult step(const RgbdFrame& frame, std::optional<double> object_depth = std::nullopt);
+  OdometryResult step(const RgbdFrame& frame, const ObjectHint& object = {});
 
   /// \brief Forgets every frame: the next one is a first frame.
   void reset();
@@ -172,7 +204,7 @@ class Odometry {
  * \brief A step's outcome as a pose source's answer (ofv::FramePose): the
  *        pose, ok for Ok and FirstFrame, source `odometry`, the status's word
  *        and the diagnostics (valid_fraction, masked_fraction,
- *        overlap_fraction, inlier_fraction, residual_m, translation_m, rotation_deg, keyframe, ms).
+ *        overlap_fraction, inlier_fraction, residual_m, still_constraint, translation_m, rotation_deg, keyframe, ms).
  */
 [[nodiscard]] FramePose frame_pose(const OdometryResult& result);
 
@@ -192,7 +224,7 @@ void validate(const OdometrySettings& settings);
 
 /// \brief The method's word: icp, rgbd_icp, fast_icp, rgbd.
 [[nodiscard]] const char* to_string(OdometryMethod method);
-/// \brief The status's word: ok, first_frame, failed, implausible.
+/// \brief The status's word: ok, first_frame, failed, implausible, degenerate.
 [[nodiscard]] const char* to_string(OdometryStatus status);
 /// \brief The method a word names.
 /// \throws std::invalid_argument naming `what` and listing the words.

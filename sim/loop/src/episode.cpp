@@ -408,7 +408,7 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
   // frames (the renderer keeps rendering from the true pose).
   const PoseSource pose_source = episode_pose_source(setup);
   const std::string poses = poses_word(setup);
-  std::optional<double> object_depth;  // the object's nearest depth in the last frame, for the pose source
+  ObjectHint object;  // the object in the last frame, for the pose source
 
   // Method hindsight: the path planned from the whole episode, tracked: the
   // command of each frame aims at where the path is when the command's
@@ -460,15 +460,14 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
       if (perception) {
         std::optional<FramePose> pose;
         if (pose_source) {
-          pose = pose_source(rendered.frame, object_depth);
+          pose = pose_source(rendered.frame, object);
           rec.pose = pose_record(poses, *pose, wMc);
         }
         const AtPose at(rendered.frame, pose);
         observation = perception->observe(rendered.frame);
         observation->pose = !pose || pose->ok ? PoseStatus::Known : PoseStatus::Unknown;
         rec.times.perception = seconds_since(start);
-        object_depth =
-            observation->problem ? nearest_depth(observation->problem->positions, observation->wMc) : std::nullopt;
+        object = observation->problem ? object_hint(observation->problem->positions, observation->wMc) : ObjectHint{};
         rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
       } else {
         observation = truth_observation(rendered.frame, std::move(gt_problem), front_end);

@@ -32,7 +32,8 @@ enum class SafetyAction {
   StaleFrame,         ///< the frame is older than stale_timeout: stop
   BadFrame,           ///< the frame failed its checks and was skipped: stop
   /// The frame's camera pose is not known (ofv::Observation::pose: RGB-D
-  /// odometry failed or found an implausible motion): stop, as for a stale frame.
+  /// odometry failed, found an implausible motion or a scene that cannot
+  /// fix it): stop, as for a stale frame.
   PoseUnknown,
 };
 /// \brief The action's words in files ("" for None, "speed limit", "stale frame", "pose unknown" ...).

@@ -29,7 +29,7 @@ struct RobotLoopOptions {
   bool pose_from_robot = false;
   /// When set, the pose the front end and the loop get: called with each
   /// frame (its pose the robot's with pose_from_robot, else its own) and
-  /// the object's nearest depth in the previous frame (ofv::nearest_depth),
+  /// the object as the front end found it in the previous frame (ofv::object_hint),
   /// before the observer; a pose it marks not ok makes the frame's
   /// Observation::pose Unknown, and the loop stops for it. RGB-D odometry:
   /// ofv::odometry::odometry_pose_source(). Frames skipped as bad do not reach it.

@@ -37,7 +37,7 @@ struct StageTimes {
  */
 struct PoseRecord {
   std::string source;  ///< the setting's word: odometry:icp, odometry:rgbd_icp, ...
-  std::string status;  ///< the source's word for the frame: ok, first_frame, failed, implausible
+  std::string status;  ///< the source's word for the frame: ok, first_frame, failed, implausible, degenerate
   /// False when the source could not tell the pose (the loop stopped for
   /// the frame: ofv::PoseStatus::Unknown, safety "pose unknown").
   bool known = true;
