@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -31,6 +32,8 @@ constexpr int kPatch = 8;
 constexpr int kPatchUsed = 48;
 constexpr double kFlat = 0.05;
 constexpr int kMinPatches = 8;
+// Ok steps whose residuals set what a step's may be (max_residual_ratio).
+constexpr std::size_t kResiduals = 9;
 
 cv::Ptr<cv::rgbd::Odometry> make_odometry(const OdometrySettings& s, const CameraIntrinsics& k) {
   cv::Mat K = (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
@@ -112,6 +115,8 @@ struct Odometry::Impl {
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  // the last good pose
   Eigen::Isometry3d wMk = Eigen::Isometry3d::Identity();  // the reference frame's pose
   Eigen::Isometry3d kMc = Eigen::Isometry3d::Identity();  // the last good pose in the reference frame
+  Eigen::Isometry3d velocity = Eigen::Isometry3d::Identity();  // the last step's motion when it was Ok
+  std::deque<double> residuals;  // of the last kResiduals Ok steps, oldest first
   cv::Ptr<cv::rgbd::OdometryFrame> reference;
 
   explicit Impl(const OdometrySettings& s) : settings(s) {}
@@ -166,12 +171,22 @@ struct Odometry::Impl {
     return cv::rgbd::OdometryFrame::create(grey, depth, mask);
   }
 
+  /// Whether a step's residual is more than max_residual_ratio times the
+  /// median of the last Ok steps' (with at least 3 of them).
+  [[nodiscard]] bool unlike_before(double residual) const {
+    if (settings.max_residual_ratio <= 0.0 || residuals.size() < 3) return false;
+    std::vector<double> r(residuals.begin(), residuals.end());
+    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+    return residual > settings.max_residual_ratio * r[r.size() / 2];
+  }
+
   /// OdometryDiagnostics::still_constraint of a frame as matched: the
-  /// normals of its flat patches of used pixels farther than object_radius
-  /// from the object's points (discs around their projections).
-  [[nodiscard]] double still_constraint(const cv::rgbd::OdometryFrame& f, const ObjectHint& object) const {
+  /// normals of the flat patches of the pixels `used` (depth in metres)
+  /// farther than object_radius from the object's points (discs around
+  /// their projections).
+  [[nodiscard]] double still_constraint(const cv::Mat& depth, const cv::Mat& used, const ObjectHint& object) const {
     const CameraIntrinsics& k = intrinsics;
-    cv::Mat away = f.mask.clone();
+    cv::Mat away = used.clone();
     for (Eigen::Index i = 0; i < object.points_c.cols(); ++i) {
       const Eigen::Vector3d p = object.points_c.col(i);
       if (!(p.z() > 1e-6) || !p.allFinite()) continue;
@@ -190,7 +205,7 @@ struct Odometry::Impl {
       for (int u0 = 0; u0 + kPatch <= k.width; u0 += kPatch) {
         points.clear();
         for (int v = v0; v < v0 + kPatch; ++v) {
-          const auto* zrow = f.depth.ptr<float>(v);
+          const auto* zrow = depth.ptr<float>(v);
           const auto* arow = away.ptr<std::uint8_t>(v);
           for (int u = u0; u < u0 + kPatch; ++u) {
             if (arow[u] == 0) continue;
@@ -223,8 +238,10 @@ struct Odometry::Impl {
   /// was masked there or hidden) tells nothing of the motion: counted as
   /// mismatches, the check failed a right motion whenever the mask changed
   /// (the object lost, no mask) or the camera saw past the occluders.
+  /// `matching` gets the pixels around the matching samples.
   void inliers(const cv::rgbd::OdometryFrame& src, const cv::rgbd::OdometryFrame& ref, const Eigen::Isometry3d& motion,
-               OdometryDiagnostics& d) const {
+               OdometryDiagnostics& d, cv::Mat& matching) const {
+    matching = cv::Mat::zeros(src.depth.size(), CV_8UC1);
     const CameraIntrinsics& k = intrinsics;
     const Eigen::Matrix3f R = motion.linear().cast<float>();
     const Eigen::Vector3f t = motion.translation().cast<float>();
@@ -253,6 +270,7 @@ struct Odometry::Impl {
         if (std::abs(diff) <= settings.max_depth_diff) {
           ++matched;
           sum += diff * diff;
+          matching(cv::Rect(u, v, std::min(kInlierStride, k.width - u), std::min(kInlierStride, k.height - v))) = 255;
         }
       }
     }
@@ -273,7 +291,8 @@ Odometry& Odometry::operator=(Odometry&&) noexcept = default;
 void Odometry::reset() {
   impl_->started = false;
   impl_->reference.release();
-  impl_->wMc = impl_->wMk = impl_->kMc = Eigen::Isometry3d::Identity();
+  impl_->wMc = impl_->wMk = impl_->kMc = impl_->velocity = Eigen::Isometry3d::Identity();
+  impl_->residuals.clear();
 }
 
 const Eigen::Isometry3d& Odometry::wMc() const { return impl_->wMc; }
@@ -294,6 +313,7 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
   }
   OdometryResult result;
   const auto finish = [&](OdometryStatus status) {
+    if (status != OdometryStatus::Ok) m.velocity = Eigen::Isometry3d::Identity();
     result.status = status;
     result.wMc = m.wMc;
     result.diagnostics.ms =
@@ -324,15 +344,20 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
 
   // What the scene cannot fix is not matched (and before OpenCV's
   // compute(), which changes the frame's mask).
-  if (m.settings.min_still_constraint > 0.0 && object.points_c.cols() > 0) {
-    d.still_constraint = m.still_constraint(*current, object);
+  const cv::Mat depth = current->depth;
+  const cv::Mat used = current->mask.clone();
+  const bool constrain = m.settings.min_still_constraint > 0.0;
+  if (constrain && object.points_c.cols() > 0) {
+    d.still_constraint = m.still_constraint(depth, used, object);
     if (d.still_constraint < m.settings.min_still_constraint) return finish(OdometryStatus::Degenerate);
   }
 
-  // The last motion as the first guess: the camera moves smoothly.
+  // The first guess: the last step's motion again from the last pose (the
+  // camera moves smoothly), or the last pose.
+  const Eigen::Isometry3d guess = m.settings.constant_velocity ? m.kMc * m.velocity : m.kMc;
   cv::Mat init(4, 4, CV_64FC1);
   for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) init.at<double>(r, c) = m.kMc.matrix()(r, c);
+    for (int c = 0; c < 4; ++c) init.at<double>(r, c) = guess.matrix()(r, c);
   }
   cv::Mat Rt;
   bool ok = false;
@@ -372,13 +397,23 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
   const Eigen::Isometry3d motion = m.wMc.inverse() * wMc;  // from the last good pose
   d.translation = motion.translation().norm();
   d.rotation = angle(motion.linear()) / kDegree;
-  m.inliers(*current, *m.reference, kMc, d);
+  cv::Mat matching;
+  m.inliers(*current, *m.reference, kMc, d, matching);
   if (d.translation > m.settings.max_translation || d.rotation > m.settings.max_rotation ||
-      d.overlap_fraction < m.settings.min_overlap_fraction || d.inlier_fraction < m.settings.min_inlier_fraction) {
+      d.overlap_fraction < m.settings.min_overlap_fraction || d.inlier_fraction < m.settings.min_inlier_fraction ||
+      m.unlike_before(d.residual)) {
     return finish(OdometryStatus::Implausible);
+  }
+  if (constrain) {
+    cv::bitwise_and(matching, used, matching);
+    d.match_constraint = m.still_constraint(depth, matching, object);
+    if (d.match_constraint < m.settings.min_still_constraint) return finish(OdometryStatus::Degenerate);
   }
   m.wMc = wMc;
   m.kMc = kMc;
+  m.velocity = motion;
+  m.residuals.push_back(d.residual);
+  if (m.residuals.size() > kResiduals) m.residuals.pop_front();
   if (!m.settings.keyframe || kMc.translation().norm() > m.settings.keyframe_translation ||
       angle(kMc.linear()) > m.settings.keyframe_rotation * kDegree) {
     m.reference = current;
@@ -437,6 +472,7 @@ FramePose frame_pose(const OdometryResult& r) {
   pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
                       {"overlap_fraction", d.overlap_fraction}, {"inlier_fraction", d.inlier_fraction},
                       {"residual_m", d.residual},             {"still_constraint", d.still_constraint},
+                      {"match_constraint", d.match_constraint},
                       {"translation_m", d.translation},       {"rotation_deg", d.rotation},
                       {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
   return pose;

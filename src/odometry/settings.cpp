@@ -51,6 +51,9 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
           [](const S& s) { return std::string(to_string(s.method)); });
     bool_row(t, "keyframe", &S::keyframe,
              "match each frame against the last keyframe (false: against the previous frame, which drifts more)");
+    bool_row(t, "constant_velocity", &S::constant_velocity,
+             "start each match from the last pose moved again by the last step's motion (false: from the last "
+             "pose)");
     number_row(t, "keyframe_translation", &S::keyframe_translation, "m",
                "a frame becomes the keyframe when the camera moved more than this from the last one", 0.0, 1.0, false);
     number_row(t, "keyframe_rotation", &S::keyframe_rotation, "deg",
@@ -71,6 +74,10 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                "a step after which fewer of the used pixels that fall on pixels the reference used are within "
                "max_depth_diff of them is implausible",
                0.0, 1.0, false);
+    number_row(t, "max_residual_ratio", &S::max_residual_ratio, "",
+               "a step after which the pixels that match the reference differ from it (RMS) by more than this "
+               "times the median of the last 9 ok steps' is implausible: one surface taken for another (0: never)",
+               0.0, 1000.0, false);
     number_row(t, "max_depth_diff", &S::max_depth_diff, "m",
                "pixels of the two frames match when their depths differ by at most this (OpenCV's maxDepthDiff)", 0.0,
                1.0, true);
