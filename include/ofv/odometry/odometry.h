@@ -100,12 +100,13 @@ struct OdometrySettings {
   /// A step whose matching pixels differ from the reference (RMS,
   /// OdometryDiagnostics::residual) by more than this times the median of
   /// the last 9 Ok steps' is implausible (0: never; with 3 Ok steps or more).
-  /// A right motion leaves the sensor's noise: 0.4-0.5 mm on the simulator's
-  /// scenes, 0.8-6.8 mm on ViSP's castel (a real SR300), growing with the
-  /// distance from the keyframe; a match that took one surface for another
-  /// within max_depth_diff, after the camera moved on while the pose was
-  /// not known, 13-22 mm against a median of 0.5 (docs/perception.md).
-  double max_residual_ratio = 5.0;
+  /// A right motion leaves the sensor's noise, growing with the distance
+  /// from the keyframe and the speed: 0.3-2 mm on the simulator's scenes,
+  /// 0.8-6.8 mm on ViSP's castel (a real SR300), at most 5.1x the median of
+  /// the steps before; a match that took one surface for another within
+  /// max_depth_diff, after the camera moved on while the pose was not known,
+  /// 15-50x (docs/perception.md).
+  double max_residual_ratio = 10.0;
   double max_depth_diff = 0.07;  ///< a pixel matches when its depth differs by at most this [m] (OpenCV's maxDepthDiff)
   double min_depth = 0.1;        ///< pixels nearer than this are not used [m]
   double max_depth = 4.0;        ///< pixels farther than this are not used [m]
