@@ -103,9 +103,9 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
     number_row(t, "mask_margin", &S::mask_margin, "m",
                "see mask: how much nearer than the object a pixel must be to be left out", 0.0, 10.0, false);
     number_row(t, "min_still_constraint", &S::min_still_constraint, "",
-               "a step is degenerate (the pose stays) when the still scene apart from the object fixes the camera's "
-               "translation less than this: the smallest eigenvalue of the mean n n^T of its flat patches' normals "
-               "(a bare table: 0; 0: never degenerate)",
+               "a step is degenerate (the pose stays) when the scene apart from the object, or the part that "
+               "matches the reference, fixes the camera's translation less than this: the smallest eigenvalue of "
+               "the mean n n^T of its flat patches' normals (a plane alone: 0; 0: never degenerate)",
                0.0, 1.0, false);
     number_row(t, "object_radius", &S::object_radius, "m",
                "pixels within this of the object's supervoxel centroids in the previous frame are the object's, not "

@@ -276,6 +276,46 @@ TEST(Odometry, ASteadyOrbitIsFollowedFromEitherGuess) {
   }
 }
 
+/// A wall at 0.6 m, tilted 30 degrees about the vertical, seen from wMc at
+/// 320x240 (exact depths: the check is about geometry, not noise).
+RgbdFrame wall(const Eigen::Isometry3d& wMc) {
+  RgbdFrame f;
+  f.intrinsics = CameraIntrinsics{320, 240, 307.5, 307.5, 160.0, 120.0};
+  f.wMc = wMc;
+  f.depth.resize(320 * 240);
+  const Eigen::Vector3d n = Eigen::AngleAxisd(30.0 * kDegree, Eigen::Vector3d::UnitY()) * Eigen::Vector3d::UnitZ();
+  const double d = n.dot(Eigen::Vector3d(0.0, 0.0, 0.6));  // the wall: n . p = d (world)
+  const Eigen::Vector3d nc = wMc.linear().transpose() * n;
+  const double dc = d - n.dot(wMc.translation());
+  for (int v = 0; v < 240; ++v) {
+    for (int u = 0; u < 320; ++u) {
+      const Eigen::Vector3d ray((u - 160.0) / 307.5, (v - 120.0) / 307.5, 1.0);
+      f.depth[static_cast<std::size_t>(v * 320 + u)] = static_cast<float>(dc / nc.dot(ray));
+    }
+  }
+  return f;
+}
+
+// A wall alone: the match stands on a plane, which fixes the motion along
+// its normal only, whatever the object (none given here): degenerate by the
+// matching pixels' own patches. The pose stays.
+TEST(Odometry, AMatchOnAPlaneAloneIsDegenerate) {
+  Odometry odometry;
+  const RgbdFrame first = wall(Eigen::Isometry3d::Identity());
+  ASSERT_EQ(odometry.step(first).status, OdometryStatus::FirstFrame);
+  const OdometryResult r = odometry.step(wall(Eigen::Isometry3d(Eigen::Translation3d(0.005, 0.0, 0.0))));
+  EXPECT_EQ(r.status, OdometryStatus::Degenerate) << to_string(r.status);
+  EXPECT_TRUE(std::isnan(r.diagnostics.still_constraint));  // no object given
+  EXPECT_LT(r.diagnostics.match_constraint, 1e-6);
+  EXPECT_TRUE(r.wMc.isApprox(first.wMc));
+  // With the check off the same step is Ok: a motion along the wall it cannot see.
+  OdometrySettings off;
+  off.min_still_constraint = 0.0;
+  Odometry unchecked(off);
+  (void)unchecked.step(first);
+  EXPECT_EQ(unchecked.step(wall(Eigen::Isometry3d(Eigen::Translation3d(0.005, 0.0, 0.0)))).status, OdometryStatus::Ok);
+}
+
 // Four frames of a still camera, then one whose right half lies 1 cm
 // deeper: every pixel is within max_depth_diff (7 cm) of the reference, but
 // no motion fits both halves, and the matching pixels differ by about 3 mm

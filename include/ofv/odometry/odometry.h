@@ -128,8 +128,9 @@ struct OdometrySettings {
   int max_width = 320;
   bool mask = true;  ///< leave out pixels nearer than the object's depth minus mask_margin, when the caller gives it
   double mask_margin = 0.10;  ///< [m] see `mask`: the hands and occluders in front of the object
-  /// A step is Degenerate when the still scene fixes the camera's
-  /// translation less than this (OdometryDiagnostics::still_constraint; 0:
+  /// A step is Degenerate when the still scene, or the part of the frame
+  /// that matches the reference, fixes the camera's translation less than
+  /// this (OdometryDiagnostics::still_constraint, match_constraint; 0:
   /// never). On the simulator's scenes (docs/perception.md): the table
   /// within the sensor's range beside a case or a cloth, or an arm over the
   /// view, 1e-5 and less; the case's holding hand or a cage 1.4e-3 and more.
