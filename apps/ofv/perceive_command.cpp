@@ -220,6 +220,7 @@ Command add_perceive_command(CLI::App& app) {
             try {
               // The poses the front end used, and the source's own to compare them with.
               std::vector<StampedPose> used, truth;
+              std::vector<StampedPose> used_ok;  // of the frames whose pose the pose source could tell
               perception::PoseSource pose_source;
 #ifdef OFV_HAVE_ODOMETRY
               std::map<std::string, long> statuses;
@@ -239,6 +240,7 @@ Command add_perceive_command(CLI::App& app) {
               const perception::PerceiveSummary summary = perception::perceive(
                   *source, ps, settings, opt->max_frames, [&](const perception::PerceivedFrame& f) {
                     used.push_back({f.frame.timestamp, f.frame.wMc});
+                    if (!f.pose || f.pose->ok) used_ok.push_back(used.back());
                     truth.push_back({f.frame.timestamp, f.source_wMc});
                     if (opt->out.empty()) {
                       std::cout << perception::perceived_frame_json(f, params) << '\n' << std::flush;
@@ -284,6 +286,10 @@ Command add_perceive_command(CLI::App& app) {
                        << "); per second " << std::setprecision(2) << 1000 * e.per_second.translation_rmse
                        << " mm (max " << 1000 * e.per_second.translation_max << "), " << std::setprecision(3)
                        << e.per_second.rotation_rmse << " deg (max " << e.per_second.rotation_max << ")";
+                  // What a user relies on: the frames the odometry called ok (aligned on the first of them).
+                  const auto [ok_rmse, ok_max] = odometry::absolute_trajectory_error(used_ok, truth);
+                  line << "; frames called ok: " << used_ok.size() << ", their ATE " << std::setprecision(2)
+                       << 1000 * ok_rmse << " mm (max " << 1000 * ok_max << ")";
                   std::cerr << line.str() << '\n';
                 }
               }
