@@ -415,8 +415,8 @@ TEST(RobotLoop, AGapInTheRecordingIsStaleAndTheRobotIsLeftAtRest) {
 
 // RobotLoopOptions::pose_source: the observer and the loop get its pose,
 // the frame keeps its own, and a frame whose pose it cannot tell stops the
-// robot (and only that frame). It is told the object's nearest depth in the
-// previous frame, as the pose it gave sees it.
+// robot (and only that frame). It is told the object as the previous frame
+// showed it, seen from the pose it gave (here its nearest depth).
 TEST(RobotLoop, APoseSourceGivesThePoseAndAFrameWithoutOneStopsTheRobot) {
   Timestamps source({0.0, 1.0 / 30, 2.0 / 30, 3.0 / 30, 4.0 / 30});
   servo::FreeFlyingCamera robot{vpHomogeneousMatrix()};
