@@ -388,6 +388,15 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     wMc.translation() = o;
     return wMc;
   };
+  // Each lattice view's last value looking at the centroid, whether it
+  // still holds (no moving body came near the view's cone of sight since),
+  // whether it is this step's; and the margin beyond step x reach from the
+  // start within which a lattice view may stand for the camera (a straight
+  // move's steps are valued at the view nearest its great circle, within 2
+  // spacings, or at its ends, K steps away, each within reach).
+  std::vector<double> kept(static_cast<std::size_t>(n), 0.0);
+  std::vector<char> holds(static_cast<std::size_t>(n), 0), valued(static_cast<std::size_t>(n), 0);
+  const double margin = 2.0 * settings.spacing + K * reach + 1e-9;
   std::vector<TriangleMesh> meshes(scenario.bodies.size());
   std::vector<std::vector<Ball>> pieces(scenario.bodies.size());  // of the bodies that moved, at the last step
   for (long i = 0; i < steps; ++i) {
@@ -409,33 +418,55 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       }
       meshes[b] = std::move(m);
     }
-    // Every lattice view looking at the centroid (the unlimited bound needs
-    // them all) that may have changed since the last step.
-    std::vector<int> evaluate;
-    std::vector<Eigen::Isometry3d> poses;
-    for (int v = 0; v < n; ++v) {
-      const Eigen::Vector3d o = position(static_cast<std::size_t>(v), i);
-      if (i > 0 && !may_change(changes, o)) {
-        looking[si][static_cast<std::size_t>(v)] = looking[si - 1][static_cast<std::size_t>(v)];
-        continue;
-      }
-      evaluate.push_back(v);
-      poses.push_back(looking_at(o, c[si], wMc_start));
+    // The lattice views looking at the centroid, first those the camera can
+    // be at by now (within step x reach of the start: no move goes farther
+    // in a step; `margin` for the views that stand for a straight move's
+    // steps), then, unless one of those sees all, every other view (the
+    // unlimited bound is the best of them all). A view keeps its last value
+    // while no moving body comes near its cone of sight.
+    for (int v = 0; v < n && i > 0; ++v) {
+      const auto sv = static_cast<std::size_t>(v);
+      if (holds[sv] && may_change(changes, position(sv, i))) holds[sv] = 0;
     }
     renderer.set_time(plan.times[si]);
-    if (!poses.empty()) {
+    std::fill(valued.begin(), valued.end(), 0);
+    double best_view = kUnreached;
+    const auto value_views = [&](bool reachable_only) {
+      std::vector<int> evaluate;
+      std::vector<Eigen::Isometry3d> poses;
+      for (int v = 0; v < n; ++v) {
+        const auto sv = static_cast<std::size_t>(v);
+        const Eigen::Vector3d o = position(sv, i);
+        if (valued[sv] || (reachable_only && (o - start).norm() > static_cast<double>(i) * reach + margin)) continue;
+        valued[sv] = 1;
+        if (holds[sv]) {
+          looking[si][sv] = kept[sv];
+          best_view = std::max(best_view, kept[sv]);
+          continue;
+        }
+        evaluate.push_back(v);
+        poses.push_back(looking_at(o, c[si], wMc_start));
+      }
+      if (poses.empty()) return;
       const std::vector<double> seen = renderer.visible_fractions(poses);
       plan.evaluations += static_cast<long>(seen.size());
-      for (std::size_t k = 0; k < seen.size(); ++k) looking[si][static_cast<std::size_t>(evaluate[k])] = seen[k];
-    }
-    plan.best_visible.push_back(*std::max_element(looking[si].begin(), looking[si].end()));
+      for (std::size_t k = 0; k < seen.size(); ++k) {
+        const auto sv = static_cast<std::size_t>(evaluate[k]);
+        looking[si][sv] = kept[sv] = seen[k];
+        holds[sv] = 1;
+        best_view = std::max(best_view, seen[k]);
+      }
+    };
+    value_views(true);
+    if (best_view < 1.0) value_views(false);  // a fraction is at most 1
+    plan.best_visible.push_back(best_view);
     // The programme's values: the camera's, which cannot look at the
     // centroid before it has turned there. Views the camera can have reached
     // by now that it could not have turned at yet are cast as turned so far;
     // the approach states reached, as the camera there is turned by now.
     std::copy(looking[si].begin(), looking[si].end(), value[si].begin());
-    evaluate.clear();
-    poses.clear();
+    std::vector<int> evaluate;
+    std::vector<Eigen::Isometry3d> poses;
     for (int v = 0; v < n && i > 0; ++v) {
       const Eigen::Vector3d o = position(static_cast<std::size_t>(v), i);
       if ((o - start).norm() > static_cast<double>(i) * reach + 1e-9) continue;  // out of reach yet

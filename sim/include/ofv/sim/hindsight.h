@@ -33,10 +33,14 @@
  *
  * The cost is at most views x steps visibility evaluations (each ray casts
  * the object's surface samples that face the view) plus views x (neighbours
- * + straight moves x segment_steps) x steps for the programme. A view whose cone of sight to the object no
- * moving body came near since the last step keeps its value, so a still
- * scene costs one step's evaluations. HindsightPlan records the views, the
- * evaluations made and the planning time.
+ * + straight moves x segment_steps) x steps for the programme. A view keeps
+ * its value while no moving body comes near its cone of sight to the object,
+ * so a still scene values each view once; and a step values only the views
+ * the camera can be at by then (within step x max_speed x the step of the
+ * start, and a margin for the views that stand for a straight move's steps)
+ * unless none of them sees the whole object, when the unlimited bound needs
+ * every view's value. HindsightPlan records the views, the evaluations made
+ * and the planning time.
  */
 #pragma once
 
