@@ -180,11 +180,9 @@ struct Odometry::Impl {
     return residual > settings.max_residual_ratio * r[r.size() / 2];
   }
 
-  /// OdometryDiagnostics::still_constraint of a frame as matched: the
-  /// normals of the flat patches of the pixels `used` (depth in metres)
-  /// farther than object_radius from the object's points (discs around
-  /// their projections).
-  [[nodiscard]] double still_constraint(const cv::Mat& depth, const cv::Mat& used, const ObjectHint& object) const {
+  /// The pixels `used` farther than object_radius from the object's points
+  /// (discs around their projections): the scene apart from the object.
+  [[nodiscard]] cv::Mat away_from(const cv::Mat& used, const ObjectHint& object) const {
     const CameraIntrinsics& k = intrinsics;
     cv::Mat away = used.clone();
     for (Eigen::Index i = 0; i < object.points_c.cols(); ++i) {
@@ -196,6 +194,14 @@ struct Odometry::Impl {
       cv::circle(away, cv::Point(static_cast<int>(std::lround(u)), static_cast<int>(std::lround(v))),
                  static_cast<int>(std::ceil(r)), cv::Scalar(0), cv::FILLED);
     }
+    return away;
+  }
+
+  /// OdometryDiagnostics::still_constraint (match_constraint) of the pixels
+  /// `away` of a frame as matched (depth in metres): the normals of their
+  /// flat patches.
+  [[nodiscard]] double constraint(const cv::Mat& depth, const cv::Mat& away) const {
+    const CameraIntrinsics& k = intrinsics;
 
     Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();
     int patches = 0;
@@ -345,10 +351,10 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
   // What the scene cannot fix is not matched (and before OpenCV's
   // compute(), which changes the frame's mask).
   const cv::Mat depth = current->depth;
-  const cv::Mat used = current->mask.clone();
   const bool constrain = m.settings.min_still_constraint > 0.0;
+  const cv::Mat away = constrain ? m.away_from(current->mask, object) : cv::Mat();
   if (constrain && object.points_c.cols() > 0) {
-    d.still_constraint = m.still_constraint(depth, used, object);
+    d.still_constraint = m.constraint(depth, away);
     if (d.still_constraint < m.settings.min_still_constraint) return finish(OdometryStatus::Degenerate);
   }
 
@@ -405,8 +411,8 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
     return finish(OdometryStatus::Implausible);
   }
   if (constrain) {
-    cv::bitwise_and(matching, used, matching);
-    d.match_constraint = m.still_constraint(depth, matching, object);
+    cv::bitwise_and(matching, away, matching);
+    d.match_constraint = m.constraint(depth, matching);
     if (d.match_constraint < m.settings.min_still_constraint) return finish(OdometryStatus::Degenerate);
   }
   m.wMc = wMc;
