@@ -206,7 +206,8 @@ class Odometry {
    *                     with OdometrySettings::mask, pixels nearer than the nearest
    *                     minus mask_margin are left out (hands, occluders); the
    *                     rest of the scene away from them must fix the motion
-   *                     (Degenerate). Empty: no mask, no such check.
+   *                     (Degenerate). Empty: no mask and no such check (the
+   *                     check of what the match stands on is made all the same).
    * \throws std::invalid_argument when the frame's buffers disagree with its
    *         intrinsics or the intrinsics change.
    */
@@ -228,7 +229,7 @@ class Odometry {
  * \brief A step's outcome as a pose source's answer (ofv::FramePose): the
  *        pose, ok for Ok and FirstFrame, source `odometry`, the status's word
  *        and the diagnostics (valid_fraction, masked_fraction,
- *        overlap_fraction, inlier_fraction, residual_m, still_constraint, translation_m, rotation_deg, keyframe, ms).
+ *        overlap_fraction, inlier_fraction, residual_m, still_constraint, match_constraint, translation_m, rotation_deg, keyframe, ms).
  */
 [[nodiscard]] FramePose frame_pose(const OdometryResult& result);
 
