@@ -229,7 +229,8 @@ class Odometry {
  * \brief A step's outcome as a pose source's answer (ofv::FramePose): the
  *        pose, ok for Ok and FirstFrame, source `odometry`, the status's word
  *        and the diagnostics (valid_fraction, masked_fraction,
- *        overlap_fraction, inlier_fraction, residual_m, still_constraint, match_constraint, translation_m, rotation_deg, keyframe, ms).
+ *        overlap_fraction, inlier_fraction, residual_m, still_constraint,
+ *        match_constraint, translation_m, rotation_deg, keyframe, ms).
  */
 [[nodiscard]] FramePose frame_pose(const OdometryResult& result);
 
