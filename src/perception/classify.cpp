@@ -119,9 +119,10 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
   // max_motion, moved with the object); from there its body grows through
   // supervoxels in contact (contact_distance, voxel to voxel) and of its
   // colour, in the sphere, not of the support plane. A body that comes to
-  // touch the object later is interacting where it touches, by the paper's
-  // rule, and an occluder beyond (a hand over a cloth's fold), until it has
-  // moved with the object (taken_by_hand()): then it is the holder.
+  // touch the object later is an occluder beyond where it touches (a hand
+  // over a cloth's fold), and where it touches too if it was an occluder in
+  // the previous frame (it came from elsewhere), until it has moved with the
+  // object (taken_by_hand()): then it is the holder.
   const std::size_t n = r.supervoxels.size();
   const bool first = r.status == TrackingStatus::Initialised;
   if (first) {
@@ -179,8 +180,30 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
     }
   }
   grow(toucher);
+  native.assign(n, 0);
   if (!first && taken_by_hand(r, toucher)) {
     for (std::size_t i = 0; i < n; ++i) body[i] = body[i] || toucher[i];
+  } else if (!first) {
+    // What came as an occluder stays one while it touches the object and
+    // has not carried it: a body that lingers against the object's face
+    // (a box 5 mm in front of a book) is not holding it, and the paper's
+    // rule alone made its touching part interacting, out of the
+    // estimator's sight. Fragments of the object that tracking has not
+    // joined were never occluders: they keep the paper's rule.
+    foreign_grid.build(foreign_voxels, radius);
+    std::vector<char> came(n, 0);
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+      if (toucher[owner] && !came[owner] && foreign_grid.any_within(r.voxels[i], radius, [](int) { return true; })) {
+        came[owner] = 1;
+        open.push_back(owner);
+      }
+    }
+    grow(came);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (came[i]) interacting[i] = 0;
+      native[i] = toucher[i] && !came[i] ? 1 : 0;  // its part beyond the touch is an occluder, not a foreign one
+    }
   }
   for (std::size_t i = 0; i < n; ++i) interacting[i] = interacting[i] || body[i];
   // Remembered as last seen, for as long as the object's hidden part is.
@@ -358,6 +381,15 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
     hidden_vertices(p, vertices.size());
   }
   r.counts.hidden_vertices = static_cast<std::size_t>(p.positions.cols()) - vertices.size();
+  foreign_voxels.clear();
+  for (std::size_t i = 0; i < r.voxels.size() && settings.holder_body && !labelled; ++i) {
+    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+    const SupervoxelInfo& s = r.supervoxels[owner];
+    if (s.label == SupervoxelClass::Occluder && !native[owner] && !on_plane(s) &&
+        !plane_voxel(s.centroid.cast<float>(), s.colour)) {
+      foreign_voxels.push_back(r.voxels[i]);
+    }
+  }
   p.occluders.resize(3, static_cast<Eigen::Index>(occluders.size()));
   for (std::size_t j = 0; j < occluders.size(); ++j) {
     p.occluders.col(static_cast<Eigen::Index>(j)) =

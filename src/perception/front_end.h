@@ -227,6 +227,14 @@ struct Perception::Impl {
     }
   } grip;
   detail::PointGrid holder_grid;
+  // classify(): the previous frame's voxels of occluders off the support
+  // plane but of the bodies that touched the object without coming as
+  // occluders (`native`, grow_holder()), hashed in foreign_grid
+  // (grow_holder(): what touches the object after coming as an occluder
+  // stays one).
+  std::vector<Eigen::Vector3f> foreign_voxels;
+  detail::PointGrid foreign_grid;
+  std::vector<char> native;  // per supervoxel of the frame (grow_holder())
   std::size_t initial_voxels = 0;        // object voxels in the first frame (seen whole)
   bool incomplete = false;  // the first frame showed an occluder cutting the object (behind_occluders())
   RgbdFrame previous;  // the previous frame's depth, pose and intrinsics (no colour), with grow_revealed: grow_revealed()
@@ -264,15 +272,16 @@ struct Perception::Impl {
   /// object_selection.cpp: the first frame's object supervoxels (1 = object);
   /// fits the support plane and sets voxel_matched. `why` says why none is found.
   std::vector<char> select(const RgbdFrame& frame, const PerceptionResult& r, std::string& why);
-  /// object_selection.cpp: the support plane (a plane holding a fifth of the
-  /// cloud, RANSAC) and its colour; supervoxels on it are never object.
-  void fit_support_plane(const PerceptionResult& r);
+  /// object_selection.cpp: the support plane (RANSAC: a plane holding a
+  /// fifth of the cloud outside the selection, or of the whole cloud with
+  /// Mode::Auto) and its colour; supervoxels on it are never object.
+  void fit_support_plane(const RgbdFrame& frame, const PerceptionResult& r);
   /// labelled.cpp (Classes::Labels): every supervoxel cut where the frame's
   /// labels change; supervoxel_labels holds each piece's label.
   void split_by_labels(const RgbdFrame& frame);
   /// labelled.cpp (Classes::Labels): the supervoxels labelled object (the
   /// first frame also fits the support plane); sets voxel_matched.
-  std::vector<char> labelled_object(const PerceptionResult& r);
+  std::vector<char> labelled_object(const RgbdFrame& frame, const PerceptionResult& r);
   /// object_memory.cpp: a later frame's object supervoxels, those near the
   /// remembered object voxels; sets voxel_matched.
   std::vector<char> track(const PerceptionResult& r);

@@ -69,8 +69,8 @@ void Perception::Impl::split_by_labels(const RgbdFrame& frame) {
   sv.touching.clear();  // only the default selection (Classes::Segmentation) reads it
 }
 
-std::vector<char> Perception::Impl::labelled_object(const PerceptionResult& r) {
-  if (!initialised) fit_support_plane(r);
+std::vector<char> Perception::Impl::labelled_object(const RgbdFrame& frame, const PerceptionResult& r) {
+  if (!initialised) fit_support_plane(frame, r);
   std::vector<char> object(r.supervoxels.size(), 0);
   for (std::size_t i = 0; i < object.size(); ++i) object[i] = supervoxel_labels[i] == kPixelObject ? 1 : 0;
   voxel_matched.assign(r.voxels.size(), 1);

@@ -65,6 +65,7 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
   const TrackingSettings& t = settings.tracking;
   const std::size_t n = r.supervoxels.size();
   const auto res = static_cast<float>(settings.supervoxels.voxel_resolution);
+  const auto radius = static_cast<float>(t.max_motion);
   // Surface the previous frame could not show, voxel by voxel (so that a
   // hand never joins through a supervoxel that mixes it with the object):
   // - hidden: behind a surface nearer its camera by more than max_motion.
@@ -162,7 +163,12 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
       contacts.for_each(x, [&](std::size_t y) {
         if (!alike(x, y)) return;
         if (object[y]) {
-          touches = true;
+          // Touching the object where the object is of this colour (its
+          // memory there): an object supervoxel at its border can mix its
+          // colour with what touches it, and through it a hand's sides,
+          // edge-on to the previous frame, joined the object (cloth-fold).
+          touches = touches ||
+                    remembered_near(r.supervoxels[y].centroid.cast<float>(), radius, chroma(r.supervoxels[x].colour));
         } else if (component[y] < 0) {
           component[y] = id;
           open.push_back(y);

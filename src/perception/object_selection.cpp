@@ -261,11 +261,26 @@ std::vector<char> select_cluster(const RgbdFrame& frame, const PerceptionResult&
 
 }  // namespace
 
-void Perception::Impl::fit_support_plane(const PerceptionResult& r) {
+void Perception::Impl::fit_support_plane(const RgbdFrame& frame, const PerceptionResult& r) {
   const std::size_t n = r.supervoxels.size();
-  const auto min_inliers = static_cast<std::size_t>(0.2 * static_cast<double>(cloud.points.size()));
-  plane = detail::fit_dominant_plane(cloud.points, settings.tracking.plane_distance,
-                                     std::max<std::size_t>(min_inliers, 3));
+  // The support is what the selection is not: with a box, a rectangle or a
+  // mask, the plane is fitted to the points outside it. Fitted to all, the
+  // dominant plane of a case seen face on above a strip of table was the
+  // case's face, and the object was nothing but plane.
+  const ObjectSelection& sel = settings.selection;
+  std::vector<Eigen::Vector3f> outside;
+  const std::vector<Eigen::Vector3f>* points = &cloud.points;
+  if (sel.mode != ObjectSelection::Mode::Auto) {
+    const Eigen::Isometry3d cMw = frame.wMc.inverse();
+    for (const Eigen::Vector3f& p : cloud.points) {
+      const bool inside = sel.mode == ObjectSelection::Mode::Box ? sel.box.contains(p.cast<double>())
+                                                                  : in_image_selection(frame, cMw, p.cast<double>(), sel);
+      if (!inside) outside.push_back(p);
+    }
+    points = &outside;
+  }
+  const auto min_inliers = static_cast<std::size_t>(0.2 * static_cast<double>(points->size()));
+  plane = detail::fit_dominant_plane(*points, settings.tracking.plane_distance, std::max<std::size_t>(min_inliers, 3));
   if (plane) {
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
     int count = 0;
@@ -284,7 +299,7 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
                                            std::string& why) {
   const std::size_t n = r.supervoxels.size();
   // The support plane: its supervoxels are never object, whatever the selection.
-  fit_support_plane(r);
+  fit_support_plane(frame, r);
   std::vector<char> off_plane(n);
   for (std::size_t i = 0; i < n; ++i) {
     off_plane[i] = on_plane(r.supervoxels[i]) ? 0 : 1;

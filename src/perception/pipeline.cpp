@@ -70,7 +70,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   stage = std::chrono::steady_clock::now();
   std::string why;
   voxel_revealed.assign(r.voxels.size(), 0);  // only track() finds revealed surface
-  const std::vector<char> object = labelled ? labelled_object(r) : initialised ? track(r) : select(frame, r, why);
+  const std::vector<char> object = labelled ? labelled_object(frame, r) : initialised ? track(r) : select(frame, r, why);
   set_status(r, object, why);
   if (r.status != TrackingStatus::Lost) {
     remember(frame, r, object);
@@ -159,6 +159,7 @@ void Perception::reset() {
   impl_->memory.clear();
   impl_->holder.clear();
   impl_->holder_age = 0;
+  impl_->foreign_voxels.clear();
   impl_->memory_chroma.clear();
   impl_->memory_age.clear();
   impl_->memory_normal.clear();

@@ -62,7 +62,8 @@ const SettingsTable<PerceptionSettings>& perception_settings_table() {
     t.add({"holder_body", "bool", format_bool(d.holder_body), "",
            "the front end (perception full): the body of what holds the object when it is selected, or of what "
            "touches it later and then carries it 2 cm, beyond the augmented OBB (in contact with it and of its "
-           "colour, in turn), is interacting too (false: the paper's classes, an occluder outside the box)"},
+           "colour, in turn), is interacting too, and what touches it after coming as an occluder stays one until "
+           "then (false: the paper's classes, an occluder outside the box)"},
           [](P& p, const std::string& v) { p.holder_body = parse_bool("holder_body", v); },
           [](const P& p) { return format_bool(p.holder_body); });
     return t;

@@ -10,6 +10,8 @@
 #include <pcl/segmentation/sac_segmentation.h>
 #include <pcl/segmentation/supervoxel_clustering.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <map>
 
@@ -123,7 +125,31 @@ std::optional<Eigen::Vector4d> fit_dominant_plane(const std::vector<Eigen::Vecto
   if (!(norm > 0.0)) {
     return std::nullopt;
   }
-  return plane / norm;
+  plane /= norm;
+  // RANSAC keeps every point within `distance`, and a plane tilted across a
+  // table seen in a narrow band keeps about as many as the table's own (2.3
+  // degrees off, 1 cm above the table at the object, on a frame of the
+  // distractors scenario): refitted (least squares) to the points within
+  // half of it, twice, it settles on the densest layer.
+  for (int pass = 0; pass < 2; ++pass) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    std::size_t count = 0;
+    for (const Eigen::Vector3f& pf : points) {
+      const Eigen::Vector3d p = pf.cast<double>();
+      if (std::abs(plane.head<3>().dot(p) + plane(3)) > 0.5 * distance) continue;
+      sum += p;
+      outer += p * p.transpose();
+      ++count;
+    }
+    if (count < 3) break;
+    const Eigen::Vector3d mean = sum / static_cast<double>(count);
+    const Eigen::Matrix3d spread = outer / static_cast<double>(count) - mean * mean.transpose();
+    Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvectors().col(0);
+    if (normal.dot(plane.head<3>()) < 0.0) normal = -normal;  // the side RANSAC gave
+    plane << normal, -normal.dot(mean);
+  }
+  return plane;
 }
 
 }  // namespace ofv::perception::detail

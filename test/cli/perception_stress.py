@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""One perception stress scenario end to end through `ofv simulate` (seed 0,
-defaults, full perception): the episode's perception block and visible
-fraction against the thresholds below (measured values in the comments).
+"""One perception stress scenario end to end through `ofv simulate` (seed 0
+unless given below, defaults, full perception): the episode's perception
+block and visible fraction against the thresholds below (measured values in
+the comments).
 
 usage: perception_stress.py OFV SCENARIO.yaml OUT_DIR
 """
@@ -10,14 +11,20 @@ import pathlib
 import subprocess
 import sys
 
-# scenario: (least mean visible, least mean occluder precision, least mean occluder recall)
-# Seed 0 measured (ofv's supervoxel stage, the default): visible / occluder precision / recall.
+# scenario: (least mean visible, least mean occluder precision, least mean occluder recall[, seed])
+# Measured (ofv's supervoxel stage, the default): visible / occluder precision / recall.
 THRESHOLDS = {
     "camera-far-off-sphere": (0.97, 0.9, 0.95),   # 0.987 / 1.000 / 1.000
-    "cloth-fold": (0.58, 0.9, 0.8),               # 0.621 / 0.999 / 0.884
+    # 0.978 / 1.000 / 1.000; lost from the first frame while the support plane was fitted to every point (the case's face)
+    "case-fills-view": (0.97, 0.9, 0.95),
+    # seed 1: 0.685 / 0.987 / 0.997, object precision 0.999; 0.970 and occluder recall 0.729 while the
+    # hand's edge-on sides joined the cloth through its border supervoxels of both colours (grow_revealed)
+    "cloth-fold": (0.58, 0.9, 0.9, 1),
     "dark-object": (0.975, 0.9, 0.95),            # 0.985 / 1.000 / 1.000
     "distractors": (0.965, 0.9, 0.95),            # 0.987 / 1.000 / 1.000
-    "hand-takes-object": (0.98, 0.5, 0.95),       # 0.993 / 0.594 / 1.000: the hand is an occluder until it has carried the case 2 cm
+    "hand-takes-object": (0.98, 0.45, 0.95),      # 0.994 / 0.507 / 1.000: the hand is an occluder until it has carried the case 2 cm
+    # 0.960 / 0.998 / 0.999; recall 0.944 while the box's part touching the book was interacting
+    "lingering-against-face": (0.94, 0.9, 0.98),
     "lingering-occluder": (0.95, 0.9, 0.95),      # 0.979 / 1.000 / 1.000
     "object-hand-colour": (0.975, 0.9, 0.95),     # 0.986 / 1.000 / 1.000
     "object-partly-outside": (0.975, 0.95, 0.95), # 0.986 / 1.000 / 1.000
@@ -27,8 +34,9 @@ THRESHOLDS = {
 
 def main():
     ofv, scenario, out = sys.argv[1], pathlib.Path(sys.argv[2]), pathlib.Path(sys.argv[3])
-    least_visible, least_precision, least_recall = THRESHOLDS[scenario.stem]
-    subprocess.run([ofv, "simulate", str(scenario), "--seed", "0", "--no-pictures", "--out", str(out)],
+    least_visible, least_precision, least_recall, *seed = THRESHOLDS[scenario.stem]
+    seed = str(seed[0] if seed else 0)
+    subprocess.run([ofv, "simulate", str(scenario), "--seed", seed, "--no-pictures", "--out", str(out)],
                    check=True, stdout=subprocess.DEVNULL)
     m = json.loads((out / "metrics.json").read_text())
     p = m["perception"]

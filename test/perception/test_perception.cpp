@@ -154,13 +154,15 @@ TEST(Perception, NormalsFaceTheCameraAndAdjacencyRespectsRadius) {
 
 class HandHolding : public testing::TestWithParam<int> {};
 
-TEST_P(HandHolding, HandIsInteractingNotObject) {
+TEST_P(HandHolding, AHandThatComesToGripIsAnOccluderNotObject) {
   const int width = GetParam();
   perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();
   ASSERT_EQ(perception.process(render(test::table_and_case(), wMc, width).frame).status,
             perception::TrackingStatus::Initialised);
-  // The hand comes in from the right, 1 cm per frame, and grips the edge.
+  // The hand comes in from the right, 1 cm per frame, and grips the edge:
+  // never the object; it came as an occluder and, not having carried the
+  // case, stays one (holder_body).
   perception::PerceptionResult r;
   Frame f;
   for (int step = 5; step >= 0; --step) {
@@ -172,7 +174,8 @@ TEST_P(HandHolding, HandIsInteractingNotObject) {
   }
   const auto truth = test::supervoxel_truth(r, f.frame, f.labels);
   EXPECT_EQ(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Object), 0);
-  EXPECT_GE(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Interacting), 1);
+  EXPECT_EQ(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Interacting), 0);
+  EXPECT_GE(test::count_truth_as(r, truth, kHand, perception::SupervoxelClass::Occluder), 1);
   const auto score = test::score_object(r, truth, kObject);
   EXPECT_GE(score.precision, 0.95);
   EXPECT_GE(score.recall, 0.90);
@@ -187,9 +190,10 @@ TEST(Perception, HolderBodyBeyondTheBoxIsInteractingWithHolderBody) {
   // holder_body the forearm of the hand that holds the case from the first
   // frame is interacting, as the hand in contact is; the post, of another
   // colour, stays an occluder. Without (the paper's classes) the forearm
-  // outside the box is an occluder; and so it is with holder_body for the
-  // same hand coming to touch the case after the first frame (a hand over a
-  // cloth's fold is not its holder).
+  // outside the box is an occluder; and with holder_body the same hand
+  // coming to touch the case after the first frame is an occluder
+  // throughout, in the box too: it came as one and has not carried the case
+  // (a hand over a cloth's fold is not its holder).
   const auto classes = [](bool holder_body, bool held_from_the_start) {
     perception::PerceptionSettings settings;
     settings.holder_body = holder_body;
@@ -226,8 +230,8 @@ TEST(Perception, HolderBodyBeyondTheBoxIsInteractingWithHolderBody) {
   EXPECT_GE(paper[1], 10);  // 21
   EXPECT_LT(paper[0], body[0]);
   EXPECT_GE(paper[3], 10);
-  EXPECT_EQ(newcomer[0], paper[0]);
-  EXPECT_EQ(newcomer[1], paper[1]);
+  EXPECT_EQ(newcomer[0], 0) << newcomer[1];
+  EXPECT_GE(newcomer[1], paper[1]);
 }
 
 TEST(Perception, ArmInFrontIsAnOccluderAndMovesTheView) {
@@ -665,6 +669,85 @@ TEST(Perception, ABodyThatCarriesTheObjectIsItsHolderOneItSlidesAlongIsNot) {
     if (k == 14) {
       EXPECT_GE(holder_c, arm_c * 9 / 10) << holder_c << " of the carrying arm's " << arm_c << " voxels";
       EXPECT_GE(occluder_s, arm_s * 9 / 10) << occluder_s << " of the static arm's " << arm_s << " voxels";
+    }
+  }
+}
+
+TEST(Perception, ACaseFaceOnThatFillsTheViewIsNotItsSupport) {
+  // The camera 17 cm in front of the case: its face is most of the image,
+  // the table a strip below. The support plane is fitted outside the
+  // selection; fitted to every point it was the case's face, and the object,
+  // all plane, was never found.
+  const Eigen::Isometry3d wMc = test::look_at(Eigen::Vector3d(0.0, -0.18, 0.09), kFrontFace);
+  for (const auto mode : {perception::ObjectSelection::Mode::Box, perception::ObjectSelection::Mode::Image}) {
+    perception::PerceptionSettings settings;
+    settings.selection.mode = mode;
+    settings.selection.box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.11, -0.03, 0.004), Eigen::Vector3d(0.11, 0.03, 0.15));
+    Frame f = render(test::table_and_case(), wMc, 320);
+    test::add_depth_noise(f.frame, 5u);
+    settings.selection.mask.assign(f.labels.size(), 0);
+    for (std::size_t i = 0; i < f.labels.size(); ++i) settings.selection.mask[i] = f.labels[i] == kObject ? 1 : 0;
+    perception::Perception perception{settings};
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << r.message;
+    const auto [seen, object] = voxels_in(r, kCaseCentre + Eigen::Vector3d(0.0, 0.0, 0.004),
+                                          Eigen::Vector3d(0.095, 0.0075, 0.0635) + Eigen::Vector3d::Constant(0.004));
+    ASSERT_GE(seen, 100);
+    EXPECT_GE(object, seen * 9 / 10) << object << " of the case's " << seen << " voxels are the object's";
+  }
+}
+
+/// Of the voxels inside `box` (centre, half size), how many there are and
+/// how many are in supervoxels of class `cls`.
+std::pair<int, int> voxels_of_class(const perception::PerceptionResult& r, const Eigen::Vector3d& centre,
+                                    const Eigen::Vector3d& half, perception::SupervoxelClass cls) {
+  int seen = 0;
+  int as = 0;
+  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+    if (((r.voxels[i].cast<double>() - centre).cwiseAbs() - half).maxCoeff() > 0.0) continue;
+    ++seen;
+    as += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == cls;
+  }
+  return {seen, as};
+}
+
+TEST(Perception, WhatComesAsAnOccluderStaysOneAgainstTheObject) {
+  // A box comes towards the case's face, from 5.5 cm in front of it, 1 cm
+  // a frame, then stays 5 mm in front of it (frames 5-10), within
+  // contact_distance: it came
+  // as an occluder and has not carried the case, so it stays an occluder,
+  // where the paper's rule alone made its touching part interacting. The
+  // same box there from the first frame is what holds the case.
+  const Eigen::Vector3d half(0.02, 0.02, 0.02);
+  const auto box_at = [&](double gap) { return Eigen::Vector3d(0.03, -0.0075 - gap - half.y(), 0.09); };
+  perception::Perception comes{perception::PerceptionSettings{}};
+  perception::Perception there{perception::PerceptionSettings{}};
+  const Eigen::Isometry3d wMc = test::front_camera();
+  for (int k = 0; k <= 10; ++k) {
+    test::SyntheticScene approach = test::table_and_case();
+    test::SyntheticScene from_start = approach;
+    const Eigen::Vector3d centre = box_at(std::max(0.055 - 0.01 * k, 0.005));
+    approach.shapes.push_back(test::make_box(centre, 2.0 * half, {60, 170, 70}, test::kOther));
+    from_start.shapes.push_back(test::make_box(box_at(0.005), 2.0 * half, {60, 170, 70}, test::kOther));
+    Frame fa = render(approach, wMc, 320);
+    Frame fs = render(from_start, wMc, 320);
+    test::add_depth_noise(fa.frame, 31u + static_cast<unsigned>(k));
+    test::add_depth_noise(fs.frame, 31u + static_cast<unsigned>(k));
+    const perception::PerceptionResult ra = comes.process(fa.frame);
+    const perception::PerceptionResult rs = there.process(fs.frame);
+    ASSERT_NE(ra.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << ra.message;
+    ASSERT_NE(rs.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rs.message;
+    // The box's voxels, not the case's face 5 mm behind it.
+    const Eigen::Vector3d region = half + Eigen::Vector3d(0.004, 0.0, 0.004);
+    const auto [seen_a, occluder_a] = voxels_of_class(ra, centre, region, perception::SupervoxelClass::Occluder);
+    const auto [seen_s, interacting_s] =
+        voxels_of_class(rs, box_at(0.005), region, perception::SupervoxelClass::Interacting);
+    ASSERT_GE(seen_a, 20) << "frame " << k;
+    EXPECT_GE(occluder_a, seen_a * 95 / 100) << "frame " << k << ": " << occluder_a << " of the box's " << seen_a
+                                             << " voxels are occluders";
+    if (k >= 5) {
+      EXPECT_GE(interacting_s, seen_s / 2) << "frame " << k << ": " << interacting_s << " of the holding box's "
+                                           << seen_s << " voxels are interacting";
     }
   }
 }
