@@ -81,7 +81,7 @@ struct TrackingSettings {
   /// object and a touching hand of another colour out; <= 0 turns it off.
   double max_chroma_distance = 0.06;
   /// The object is lost when fewer of its voxels than this fraction of the
-  /// previous frame's are found (the last known state is kept for re-acquisition).
+  /// first frame's are found (the last known state is kept for re-acquisition).
   double min_kept_fraction = 0.2;
   /// Object voxels not seen in a frame (behind something nearer the camera,
   /// out of the image, or on a pixel with no depth where the frame does not
