@@ -617,6 +617,14 @@ TEST(Perception, ThePartBeyondTheFirstImageJoinsTheObjectAsItComesIn) {
   }
 }
 
+/// `scene` seen from wMc at 320 px with depth noise of `noise_seed`, through `perception`.
+perception::PerceptionResult noisy_step(perception::Perception& perception, const test::SyntheticScene& scene,
+                                        const Eigen::Isometry3d& wMc, unsigned noise_seed) {
+  Frame f = render(scene, wMc, 320);
+  test::add_depth_noise(f.frame, noise_seed);
+  return perception.process(f.frame);
+}
+
 /// Of the voxels of an arm reaching from the right beyond the case's
 /// augmented box (x > 0.14), how many there are and how many are in
 /// supervoxels of class `cls`.
@@ -652,12 +660,8 @@ TEST(Perception, ABodyThatCarriesTheObjectIsItsHolderOneItSlidesAlongIsNot) {
     test::SyntheticScene along = with;
     with.shapes.push_back(arm(gap, lift));
     along.shapes.push_back(arm(gap, 0.0));
-    Frame fc = render(with, wMc, 320);
-    Frame fs = render(along, wMc, 320);
-    test::add_depth_noise(fc.frame, 21u + static_cast<unsigned>(k));
-    test::add_depth_noise(fs.frame, 21u + static_cast<unsigned>(k));
-    const perception::PerceptionResult rc = carried.process(fc.frame);
-    const perception::PerceptionResult rs = slides.process(fs.frame);
+    const perception::PerceptionResult rc = noisy_step(carried, with, wMc, 21u + static_cast<unsigned>(k));
+    const perception::PerceptionResult rs = noisy_step(slides, along, wMc, 21u + static_cast<unsigned>(k));
     ASSERT_NE(rc.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rc.message;
     ASSERT_NE(rs.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rs.message;
     const auto [arm_c, holder_c] = arm_voxels(rc, perception::SupervoxelClass::Interacting);
@@ -729,12 +733,8 @@ TEST(Perception, WhatComesAsAnOccluderStaysOneAgainstTheObject) {
     const Eigen::Vector3d centre = box_at(std::max(0.055 - 0.01 * k, 0.005));
     approach.shapes.push_back(test::make_box(centre, 2.0 * half, {60, 170, 70}, test::kOther));
     from_start.shapes.push_back(test::make_box(box_at(0.005), 2.0 * half, {60, 170, 70}, test::kOther));
-    Frame fa = render(approach, wMc, 320);
-    Frame fs = render(from_start, wMc, 320);
-    test::add_depth_noise(fa.frame, 31u + static_cast<unsigned>(k));
-    test::add_depth_noise(fs.frame, 31u + static_cast<unsigned>(k));
-    const perception::PerceptionResult ra = comes.process(fa.frame);
-    const perception::PerceptionResult rs = there.process(fs.frame);
+    const perception::PerceptionResult ra = noisy_step(comes, approach, wMc, 31u + static_cast<unsigned>(k));
+    const perception::PerceptionResult rs = noisy_step(there, from_start, wMc, 31u + static_cast<unsigned>(k));
     ASSERT_NE(ra.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << ra.message;
     ASSERT_NE(rs.status, perception::TrackingStatus::Lost) << "frame " << k << ": " << rs.message;
     // The box's voxels, not the case's face 5 mm behind it.
