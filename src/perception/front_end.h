@@ -227,11 +227,11 @@ struct Perception::Impl {
     }
   } grip;
   detail::PointGrid holder_grid;
-  // classify(): the previous frame's voxels of occluders off the support
-  // plane but of the bodies that touched the object without coming as
-  // occluders (`native`, grow_holder()), hashed in foreign_grid
-  // (grow_holder(): what touches the object after coming as an occluder
-  // stays one).
+  // classify(): the previous frame's occluder voxels off the support plane,
+  // but for those of bodies that touched the object without coming as
+  // occluders (`native`, grow_holder()); hashed in foreign_grid by
+  // grow_holder(): what touches the object after coming as an occluder
+  // stays one.
   std::vector<Eigen::Vector3f> foreign_voxels;
   detail::PointGrid foreign_grid;
   std::vector<char> native;  // per supervoxel of the frame (grow_holder())

@@ -182,10 +182,10 @@ struct PerceptionSettings {
   /// paper's classes (false) make them occluders, which send the camera
   /// away from views they seldom block. A body that comes to touch the
   /// object later keeps the paper's classes (a hand over a cloth's fold:
-  /// interacting where it touches, an occluder beyond), but where it touches
-  /// too when it was an occluder in the frame before (it came from
-  /// elsewhere: a box lingering against the object's face), until it has
-  /// taken the object: once the object has moved 2 cm since the body first
+  /// interacting where it touches, an occluder beyond), or, when it was an
+  /// occluder in the frame before (it came from elsewhere: a box lingering
+  /// against the object's face), is an occluder where it touches too, until
+  /// it has taken the object: once the object has moved 2 cm since the body first
   /// touched it, and the body's voxels of then, carried by the object's
   /// estimated motion, lie on the body at less than half the distance of
   /// the same voxels left where they were, it is the holder.
