@@ -382,12 +382,14 @@ void Perception::Impl::classify(const RgbdFrame& frame, PerceptionResult& r, con
   }
   r.counts.hidden_vertices = static_cast<std::size_t>(p.positions.cols()) - vertices.size();
   foreign_voxels.clear();
-  for (std::size_t i = 0; i < r.voxels.size() && settings.holder_body && !labelled; ++i) {
-    const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
-    const SupervoxelInfo& s = r.supervoxels[owner];
-    if (s.label == SupervoxelClass::Occluder && !native[owner] && !on_plane(s) &&
-        !plane_voxel(s.centroid.cast<float>(), s.colour)) {
-      foreign_voxels.push_back(r.voxels[i]);
+  if (settings.holder_body && !labelled) {  // grow_holder() ran and set `native`
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+      const SupervoxelInfo& s = r.supervoxels[owner];
+      if (s.label == SupervoxelClass::Occluder && !native[owner] && !on_plane(s) &&
+          !plane_voxel(s.centroid.cast<float>(), s.colour)) {
+        foreign_voxels.push_back(r.voxels[i]);
+      }
     }
   }
   p.occluders.resize(3, static_cast<Eigen::Index>(occluders.size()));

@@ -84,17 +84,6 @@ std::vector<std::vector<int>> colour_clusters(const std::vector<SupervoxelInfo>&
   return out;
 }
 
-/// ObjectSelection::Mode::Box: the supervoxels off the plane whose centroid is in `box`.
-std::vector<char> select_in_box(const std::vector<SupervoxelInfo>& supervoxels,
-                                const std::vector<char>& off_plane,
-                                const Eigen::AlignedBox3d& box) {
-  std::vector<char> object(supervoxels.size(), 0);
-  for (std::size_t i = 0; i < supervoxels.size(); ++i) {
-    object[i] = off_plane[i] && box.contains(supervoxels[i].centroid) ? 1 : 0;
-  }
-  return object;
-}
-
 /// True when p (world frame) projects onto a mask pixel or into the rectangle.
 bool in_image_selection(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
                         const ObjectSelection& sel) {
@@ -108,15 +97,21 @@ bool in_image_selection(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, co
   return sel.rect.contains(Eigen::Vector2i(u, v));
 }
 
-/// ObjectSelection::Mode::Image: the supervoxels off the plane whose centroid
-/// projects onto a mask pixel or into the rectangle.
-std::vector<char> select_in_image(const RgbdFrame& frame,
-                                  const std::vector<SupervoxelInfo>& supervoxels,
-                                  const std::vector<char>& off_plane, const ObjectSelection& sel) {
+/// True when p (world frame) is inside the selection: the box
+/// (Mode::Box), or the mask or rectangle it projects onto (Mode::Image).
+bool in_selection(const RgbdFrame& frame, const Eigen::Isometry3d& cMw, const Eigen::Vector3d& p,
+                  const ObjectSelection& sel) {
+  return sel.mode == ObjectSelection::Mode::Box ? sel.box.contains(p) : in_image_selection(frame, cMw, p, sel);
+}
+
+/// ObjectSelection::Mode::Box and Mode::Image: the supervoxels off the plane
+/// whose centroid is inside the selection (in_selection()).
+std::vector<char> select_inside(const RgbdFrame& frame, const std::vector<SupervoxelInfo>& supervoxels,
+                                const std::vector<char>& off_plane, const ObjectSelection& sel) {
   std::vector<char> object(supervoxels.size(), 0);
   const Eigen::Isometry3d cMw = frame.wMc.inverse();
   for (std::size_t i = 0; i < supervoxels.size(); ++i) {
-    object[i] = off_plane[i] && in_image_selection(frame, cMw, supervoxels[i].centroid, sel) ? 1 : 0;
+    object[i] = off_plane[i] && in_selection(frame, cMw, supervoxels[i].centroid, sel) ? 1 : 0;
   }
   return object;
 }
@@ -273,9 +268,7 @@ void Perception::Impl::fit_support_plane(const RgbdFrame& frame, const Perceptio
   if (sel.mode != ObjectSelection::Mode::Auto) {
     const Eigen::Isometry3d cMw = frame.wMc.inverse();
     for (const Eigen::Vector3f& p : cloud.points) {
-      const bool inside = sel.mode == ObjectSelection::Mode::Box ? sel.box.contains(p.cast<double>())
-                                                                  : in_image_selection(frame, cMw, p.cast<double>(), sel);
-      if (!inside) outside.push_back(p);
+      if (!in_selection(frame, cMw, p.cast<double>(), sel)) outside.push_back(p);
     }
     points = &outside;
   }
@@ -310,11 +303,11 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
   std::string if_none;
   switch (sel.mode) {
     case ObjectSelection::Mode::Box:
-      object = select_in_box(r.supervoxels, off_plane, sel.box);
+      object = select_inside(frame, r.supervoxels, off_plane, sel);
       if_none = "no supervoxel inside the selection box";
       break;
     case ObjectSelection::Mode::Image:
-      object = select_in_image(frame, r.supervoxels, off_plane, sel);
+      object = select_inside(frame, r.supervoxels, off_plane, sel);
       if_none = "no supervoxel inside the image selection";
       break;
     case ObjectSelection::Mode::Auto:
