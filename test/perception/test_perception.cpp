@@ -490,17 +490,24 @@ TEST(Perception, DistractorOfTheObjectsColourStaysOutAsTheObjectRevealsIt) {
 }
 
 /// Of the voxels inside `box` (centre, half size), how many there are and
-/// how many are in object supervoxels.
-std::pair<int, int> voxels_in(const perception::PerceptionResult& r, const Eigen::Vector3d& centre,
-                              const Eigen::Vector3d& half) {
+/// how many are in supervoxels of class `cls`.
+std::pair<int, int> voxels_of_class(const perception::PerceptionResult& r, const Eigen::Vector3d& centre,
+                                    const Eigen::Vector3d& half, perception::SupervoxelClass cls) {
   int seen = 0;
-  int object = 0;
+  int as = 0;
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     if (((r.voxels[i].cast<double>() - centre).cwiseAbs() - half).maxCoeff() > 0.0) continue;
     ++seen;
-    object += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == perception::SupervoxelClass::Object;
+    as += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == cls;
   }
-  return {seen, object};
+  return {seen, as};
+}
+
+/// Of the voxels inside `box` (centre, half size), how many there are and
+/// how many are in object supervoxels.
+std::pair<int, int> voxels_in(const perception::PerceptionResult& r, const Eigen::Vector3d& centre,
+                              const Eigen::Vector3d& half) {
+  return voxels_of_class(r, centre, half, perception::SupervoxelClass::Object);
 }
 
 /// Both supervoxel stages: ofv's (the default) and PCL's (the reference).
@@ -699,20 +706,6 @@ TEST(Perception, ACaseFaceOnThatFillsTheViewIsNotItsSupport) {
     ASSERT_GE(seen, 100);
     EXPECT_GE(object, seen * 9 / 10) << object << " of the case's " << seen << " voxels are the object's";
   }
-}
-
-/// Of the voxels inside `box` (centre, half size), how many there are and
-/// how many are in supervoxels of class `cls`.
-std::pair<int, int> voxels_of_class(const perception::PerceptionResult& r, const Eigen::Vector3d& centre,
-                                    const Eigen::Vector3d& half, perception::SupervoxelClass cls) {
-  int seen = 0;
-  int as = 0;
-  for (std::size_t i = 0; i < r.voxels.size(); ++i) {
-    if (((r.voxels[i].cast<double>() - centre).cwiseAbs() - half).maxCoeff() > 0.0) continue;
-    ++seen;
-    as += r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label == cls;
-  }
-  return {seen, as};
 }
 
 TEST(Perception, WhatComesAsAnOccluderStaysOneAgainstTheObject) {
