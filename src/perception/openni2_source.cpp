@@ -67,21 +67,35 @@ struct Device {
   openni::VideoStream colour;
   bool has_colour = false;
 
+  bool depth_started = false;
+  bool colour_started = false;
+
   ~Device() {
-    if (depth.isValid()) {
-      depth.stop();
-    }
-    if (colour.isValid()) {
-      colour.stop();
-    }
-    // Some drivers (DummyDevice) do not join their threads on stop():
-    // destroying right away can crash (PLATFORM-NOTES). Once per device
-    // opened; 200 ms rather than the 50 ms that sufficed on an idle
-    // machine, since a loaded one can starve the driver's thread that long.
+    // DummyDevice's stream thread marks itself running when it first runs,
+    // after start() returned: a stop() before that is lost, and the thread
+    // then delivers frames to a destroyed stream (a crash, or another
+    // stream's frame in a stream created later at the same address; seen
+    // in 31 of 40 runs of a source closed before its first frame, with the
+    // machine loaded). A frame from each started stream proves its thread
+    // runs: wait for one (at most a second) before stopping it.
+    stop(depth, depth_started);
+    stop(colour, colour_started);
+    // Nor does it join its threads on stop(): destroying right away can
+    // crash (PLATFORM-NOTES). Once per device opened; 200 ms rather than
+    // the 50 ms that sufficed on an idle machine, since a loaded one can
+    // starve the driver's thread that long.
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     depth.destroy();
     colour.destroy();
     device.close();
+  }
+
+  static void stop(openni::VideoStream& stream, bool started) {
+    if (!started) return;
+    openni::VideoStream* streams[] = {&stream};
+    int ready = -1;
+    (void)openni::OpenNI::waitForAnyStream(streams, 1, &ready, 1000);
+    stream.stop();
   }
 };
 
@@ -151,9 +165,11 @@ void OpenNi2Source::open_device() {
   if (dev->depth.start() != openni::STATUS_OK) {
     throw std::runtime_error(uri_ + ": cannot start the depth stream: " + last_error());
   }
+  dev->depth_started = true;
   if (dev->has_colour && dev->colour.start() != openni::STATUS_OK) {
     throw std::runtime_error(uri_ + ": cannot start the colour stream: " + last_error());
   }
+  dev->colour_started = dev->has_colour;
   impl_->live = std::move(dev);
 }
 
