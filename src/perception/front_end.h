@@ -292,7 +292,12 @@ struct Perception::Impl {
   void grow_revealed(const PerceptionResult& r, const std::vector<int>& near, std::vector<char>& object);
   /// pipeline.cpp: r.status and r.message from the object found; the first
   /// frame found also sets the state's start (initialised, initial_voxels).
-  void set_status(PerceptionResult& r, const std::vector<char>& object, std::string why);
+  void set_status(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object, std::string why);
+  /// The memory voxels whose normal faces the frame's camera (or that have
+  /// none) and whose pixel has a depth, nearer or not: as many object
+  /// voxels as the view could show (the sensor measures no surface seen
+  /// too obliquely).
+  [[nodiscard]] std::size_t remembered_in_view(const RgbdFrame& frame) const;
   /// object_memory.cpp: the object's rigid motion from the previous frame
   /// to this one (world frame), from its visible voxels matched against the
   /// memory; identity when it cannot be told (TrackingSettings::follow_motion).

@@ -71,7 +71,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   std::string why;
   voxel_revealed.assign(r.voxels.size(), 0);  // only track() finds revealed surface
   const std::vector<char> object = labelled ? labelled_object(frame, r) : initialised ? track(r) : select(frame, r, why);
-  set_status(r, object, why);
+  set_status(frame, r, object, why);
   if (r.status != TrackingStatus::Lost) {
     remember(frame, r, object);
   }
@@ -114,7 +114,20 @@ void Perception::Impl::adjacency(PerceptionResult& r) {
   r.counts.adjacency_edges = r.adjacency.size();
 }
 
-void Perception::Impl::set_status(PerceptionResult& r, const std::vector<char>& object,
+std::size_t Perception::Impl::remembered_in_view(const RgbdFrame& frame) const {
+  const Eigen::Isometry3d cMw = frame.wMc.inverse();
+  const Eigen::Vector3f camera = frame.wMc.translation().cast<float>();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < memory.size(); ++i) {
+    const bool facing = memory_normal[i].isZero() || memory_normal[i].dot(camera - memory[i]) > 0.0f;
+    if (!facing) continue;
+    const auto l = detail::look(frame, cMw, memory[i].cast<double>());
+    n += l && l->measured() ? 1u : 0u;
+  }
+  return n;
+}
+
+void Perception::Impl::set_status(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object,
                                   std::string why) {
   std::size_t object_voxels = 0;
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
@@ -127,10 +140,17 @@ void Perception::Impl::set_status(PerceptionResult& r, const std::vector<char>& 
   if (!lost && initialised &&
       static_cast<double>(object_voxels) <
           settings.tracking.min_kept_fraction * static_cast<double>(initial_voxels)) {
-    lost = true;
-    why = std::to_string(object_voxels) + " object voxels found, fewer than " +
-          std::to_string(settings.tracking.min_kept_fraction) + " x the " +
-          std::to_string(initial_voxels) + " of the first frame";
+    // As many as this view can show: the first frame's, unless the
+    // remembered object (seen or hidden) has fewer facing the camera where
+    // the sensor measures depth (a face seen edge-on gives none).
+    const std::size_t can_show = std::min(initial_voxels, remembered_in_view(frame));
+    if (static_cast<double>(object_voxels) < settings.tracking.min_kept_fraction * static_cast<double>(can_show)) {
+      lost = true;
+      why = std::to_string(object_voxels) + " object voxels found, fewer than " +
+            std::to_string(settings.tracking.min_kept_fraction) + " x the " + std::to_string(can_show) +
+            " this view can show (the first frame's " + std::to_string(initial_voxels) +
+            ", or the remembered ones facing the camera on pixels with depth)";
+    }
   }
   if (lost) {
     r.status = TrackingStatus::Lost;

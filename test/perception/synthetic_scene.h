@@ -151,6 +151,9 @@ inline std::optional<std::pair<double, Eigen::Vector3d>> intersect(const Shape& 
 /// A world of shapes seen by one camera.
 struct SyntheticScene {
   std::vector<Shape> shapes;
+  /// A surface met more obliquely than this (ray to normal) has no depth,
+  /// as on a real sensor; its colour stays.
+  double grazing_deg = 90.0;
 
   /// Renders depth (Z [m]), colour (Lambert-like shading) and labels.
   RgbdFrame render(const CameraIntrinsics& k, const Eigen::Isometry3d& wMc,
@@ -184,7 +187,9 @@ struct SyntheticScene {
           continue;
         }
         const std::size_t i = f.index(u, v);
-        f.depth[i] = static_cast<float>(best * d.dot(wMc.linear().col(2)));
+        if (std::abs(normal.dot(d)) >= std::cos(grazing_deg * M_PI / 180.0)) {
+          f.depth[i] = static_cast<float>(best * d.dot(wMc.linear().col(2)));
+        }
         const double shade = 0.6 + 0.4 * std::abs(normal.dot(d));
         for (int c = 0; c < 3; ++c) {
           f.rgb[3 * i + static_cast<std::size_t>(c)] =

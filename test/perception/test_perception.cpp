@@ -393,6 +393,35 @@ TEST(Perception, ReportsALostObjectAndFindsItAgain) {
   EXPECT_LE((back.centroid - kFrontFace).norm(), 0.01);
 }
 
+TEST(Perception, AFaceSeenEdgeOnIsNotALostObject) {
+  // The camera rises over the case's top edge until its face is met at 82
+  // degrees, where the sensor measures no depth (grazing drop-out at 75
+  // degrees): the view shows the case's top, a tenth of the first frame's
+  // voxels, and nothing hides it. A status lost (fewer than
+  // min_kept_fraction of the first frame's voxels) would send the camera
+  // back; the object is as seen as this view can show it.
+  perception::Perception perception{perception::PerceptionSettings{}};
+  test::SyntheticScene scene = test::table_and_case();
+  scene.grazing_deg = 75.0;
+  for (int k = 0; k <= 14; ++k) {
+    const double e = (26.0 + 4.0 * k) * M_PI / 180.0;  // elevation 26 to 82 degrees
+    const Eigen::Vector3d eye = kCaseCentre + 0.5 * Eigen::Vector3d(0.0, -std::cos(e), std::sin(e));
+    const Frame f = render(scene, test::look_at(eye, kCaseCentre), 320);
+    const perception::PerceptionResult r = perception.process(f.frame);
+    ASSERT_NE(r.status, perception::TrackingStatus::Lost) << "elevation " << 26 + 4 * k << ": " << r.message;
+    const auto score = test::score_object(r, test::supervoxel_truth(r, f.frame, f.labels), kObject);
+    EXPECT_GE(score.precision, 0.95) << "elevation " << 26 + 4 * k;
+  }
+  // The same case behind a board that leaves a tenth of its face in view is lost.
+  test::SyntheticScene hidden = test::table_and_case();
+  hidden.shapes.push_back(test::make_box({0.01, -0.1, 0.0675}, {0.2, 0.01, 0.2}, kSkin, kHand));
+  perception::Perception again{perception::PerceptionSettings{}};
+  ASSERT_EQ(again.process(render(test::table_and_case(), test::front_camera()).frame).status,
+            perception::TrackingStatus::Initialised);
+  const perception::PerceptionResult r = again.process(render(hidden, test::front_camera()).frame);
+  EXPECT_EQ(r.status, perception::TrackingStatus::Lost);
+}
+
 TEST(Perception, OccludedPartIsRecognisedWhenItReappears) {
   perception::Perception perception{perception::PerceptionSettings{}};
   const Eigen::Isometry3d wMc = test::front_camera();

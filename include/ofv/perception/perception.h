@@ -80,8 +80,11 @@ struct TrackingSettings {
   /// matter): Euclidean distance at most this. Keeps the table under the
   /// object and a touching hand of another colour out; <= 0 turns it off.
   double max_chroma_distance = 0.06;
-  /// The object is lost when fewer of its voxels than this fraction of the
-  /// first frame's are found (the last known state is kept for re-acquisition).
+  /// The object is lost when fewer of its voxels than this fraction of what
+  /// the view can show are found: the first frame's count, or fewer where
+  /// the remembered object (seen or hidden) has fewer voxels facing the
+  /// camera on pixels with depth (a face seen edge-on shows its edge). The
+  /// last known state is kept for re-acquisition.
   double min_kept_fraction = 0.2;
   /// Object voxels not seen in a frame (behind something nearer the camera,
   /// out of the image, or on a pixel with no depth where the frame does not
