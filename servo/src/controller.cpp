@@ -3,6 +3,7 @@
 
 #include "ofv/servo/target_pose.h"
 
+#include <algorithm>
 #include <visp3/visual_features/vpFeatureThetaU.h>
 #include <visp3/visual_features/vpFeatureTranslation.h>
 #include <visp3/vs/vpAdaptiveGain.h>
@@ -49,12 +50,8 @@ vpColVector saturate(const vpColVector& v, double max_linear, double max_angular
   }
   lin = std::sqrt(lin);
   ang = std::sqrt(ang);
-  if (lin > max_linear) {
-    for (unsigned i = 0; i < 3; ++i) out[i] *= max_linear / lin;
-  }
-  if (ang > max_angular) {
-    for (unsigned i = 3; i < 6; ++i) out[i] *= max_angular / ang;
-  }
+  const double k = std::min({1.0, lin > 0.0 ? max_linear / lin : 1.0, ang > 0.0 ? max_angular / ang : 1.0});
+  if (k < 1.0) out *= k;
   return out;
 }
 

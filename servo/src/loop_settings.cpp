@@ -88,13 +88,13 @@ SettingsTable<LoopSettings> make_table() {
         [](L& l, const std::string& v) { l.controller.adaptive_gain = parse_bool("adaptive_gain", v); },
         [](const L& l) { return format_bool(l.controller.adaptive_gain); });
   t.add({"max_linear_speed", "number in (0, 10]", format_number(d.controller.max_linear_speed), "m/s",
-         "the controller scales the linear velocity down to this; the safety filter enforces it"},
+         "the controller scales its whole twist down until the linear velocity is within this (rotation alike: C stays centred); the safety filter enforces it"},
         [](L& l, const std::string& v) {
           l.controller.max_linear_speed = l.safety.max_linear_speed = parse_number("max_linear_speed", v, 0.0, 10.0, true);
         },
         [](const L& l) { return format_number(l.controller.max_linear_speed); });
   t.add({"max_angular_speed", "number in (0, 20]", format_number(d.controller.max_angular_speed), "rad/s",
-         "the controller scales the angular velocity down to this; the safety filter enforces it"},
+         "the controller scales its whole twist down until the angular velocity is within this (translation alike); the safety filter enforces it"},
         [](L& l, const std::string& v) {
           l.controller.max_angular_speed = l.safety.max_angular_speed =
               parse_number("max_angular_speed", v, 0.0, 20.0, true);

@@ -134,6 +134,32 @@ TEST(ViewController, CommandsAreBoundedAndFinite) {
   EXPECT_THROW(servo::ViewController{bad}, std::invalid_argument);
 }
 
+TEST(ViewController, ASaturatedCommandKeepsTheObjectCentred) {
+  // A target view 150 degrees round the sphere asks for more than both
+  // speed limits at once. The twist is scaled as a whole: the translation
+  // and the rotation that keeps C centred while it moves stay in step. (Each
+  // part saturated on its own, the camera looked 48 degrees off C.)
+  const Eigen::Vector3d c(0, 0, 0.5);
+  const double r = 0.5, a = 150.0 * kPi / 180.0;
+  const Eigen::Vector3d tf = c + r * Eigen::Vector3d(std::sin(a), 0.0, -std::cos(a));
+  servo::ControllerSettings settings;
+  settings.gain = 4.0;
+  servo::ViewController controller(settings);
+  servo::FreeFlyingCamera camera(looking_at({0, 0, 0}, c));
+  double worst = 0.0;
+  for (int k = 0; k < 90; ++k) {
+    const vpColVector v = controller.update(tf, c, r, camera.wMc(), 1.0 / 30);
+    EXPECT_LE(std::hypot(v[0], v[1], v[2]), settings.max_linear_speed + 1e-12);
+    EXPECT_LE(std::hypot(v[3], v[4], v[5]), settings.max_angular_speed + 1e-12);
+    camera.step(v, 1.0 / 30);
+    const Eigen::Isometry3d m = servo::to_eigen(camera.wMc());
+    const Eigen::Vector3d axis = m.linear().col(2);
+    worst = std::max(worst, std::acos(std::min(1.0, axis.dot((c - m.translation()).normalized()))));
+  }
+  EXPECT_LT(worst, 1.0 * kPi / 180.0);
+  EXPECT_LT((servo::to_eigen(camera.wMc()).translation() - tf).norm(), 0.01);
+}
+
 TEST(Robots, FollowAConstantTwist) {
   const vpHomogeneousMatrix start = looking_at({0, 0, 0}, {0, 0, 0.5});
   const vpColVector v{0.05, -0.02, 0.03, 0.1, -0.05, 0.08};

@@ -90,7 +90,10 @@ class ViewController {
   double last_error_ = 0.0;
 };
 
-/// \brief Scales the linear and angular parts of a twist to the limits (direction kept).
+/// \brief Scales a twist by one factor, the largest that keeps its linear part
+/// within max_linear [m/s] and its angular part within max_angular [rad/s]:
+/// the twist's direction is kept, so a task's rotation stays in step with its
+/// translation (the sphere law's centring of C), only slower.
 [[nodiscard]] vpColVector saturate(const vpColVector& v, double max_linear, double max_angular);
 
 }  // namespace ofv::servo
