@@ -67,7 +67,8 @@ vpColVector SafetyFilter::filter(const vpColVector& v_in, const vpHomogeneousMat
   action_ = SafetyAction::None;
   vpColVector v = saturate(v_in, settings_.max_linear_speed, settings_.max_angular_speed);
   if (v != v_in) action_ = SafetyAction::SpeedLimit;
-  // Acceleration: the change from the previous command, per part.
+  // Acceleration: the change from the previous command, scaled as a whole
+  // until each part is within its limit (as the speed above).
   const vpColVector dv = v - previous_;
   const vpColVector limited = saturate(dv, settings_.max_linear_accel * dt, settings_.max_angular_accel * dt);
   if (limited != dv) {
