@@ -137,14 +137,16 @@ void Perception::Impl::set_status(const RgbdFrame& frame, PerceptionResult& r, c
   if (lost && why.empty()) {
     why = "no supervoxel near the object's last state";
   }
-  if (!lost && initialised &&
-      static_cast<double>(object_voxels) <
-          settings.tracking.min_kept_fraction * static_cast<double>(initial_voxels)) {
+  const auto too_few = [&](std::size_t of) {
+    return static_cast<double>(object_voxels) < settings.tracking.min_kept_fraction * static_cast<double>(of);
+  };
+  if (!lost && initialised && too_few(initial_voxels)) {
     // As many as this view can show: the first frame's, unless the
     // remembered object (seen or hidden) has fewer facing the camera where
-    // the sensor measures depth (a face seen edge-on gives none).
+    // the sensor measures depth (a face seen edge-on gives none). Counted
+    // only when the first frame's alone would call the object lost.
     const std::size_t can_show = std::min(initial_voxels, remembered_in_view(frame));
-    if (static_cast<double>(object_voxels) < settings.tracking.min_kept_fraction * static_cast<double>(can_show)) {
+    if (too_few(can_show)) {
       lost = true;
       why = std::to_string(object_voxels) + " object voxels found, fewer than " +
             std::to_string(settings.tracking.min_kept_fraction) + " x the " + std::to_string(can_show) +

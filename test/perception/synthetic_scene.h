@@ -169,6 +169,7 @@ struct SyntheticScene {
       labels->assign(n, kNone);
     }
     const Eigen::Vector3d o = wMc.translation();
+    const double cos_grazing = std::cos(grazing_deg * M_PI / 180.0);
     for (int v = 0; v < k.height; ++v) {
       for (int u = 0; u < k.width; ++u) {
         const Eigen::Vector3d dc((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
@@ -187,7 +188,7 @@ struct SyntheticScene {
           continue;
         }
         const std::size_t i = f.index(u, v);
-        if (std::abs(normal.dot(d)) >= std::cos(grazing_deg * M_PI / 180.0)) {
+        if (std::abs(normal.dot(d)) >= cos_grazing) {
           f.depth[i] = static_cast<float>(best * d.dot(wMc.linear().col(2)));
         }
         const double shade = 0.6 + 0.4 * std::abs(normal.dot(d));
