@@ -12,6 +12,7 @@
 #pragma once
 
 #include "ofv/estimator.h"
+#include "ofv/pose_source.h"
 #include "ofv/rgbd_frame.h"
 
 #include <Eigen/Core>
@@ -49,6 +50,9 @@ struct Observation {
   /// Pose of the camera that took the frame (world ← camera): the frame's
   /// own, or a pose source's (ofv::PoseSource, e.g. RGB-D odometry).
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();
+  /// The still plane the object stands on (world frame), when the front end
+  /// found one: a pose source keeps its pixels.
+  std::optional<SupportPlane> support_plane;
   /// Whether `wMc` is known for this frame: a pose source that could not
   /// tell it leaves its last good pose in `wMc` and says Unknown here; the
   /// loop then stops, as for a stale frame. The driver sets it.

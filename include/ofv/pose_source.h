@@ -37,15 +37,24 @@ struct FramePose {
   std::vector<std::pair<std::string, double>> diagnostics;  ///< numbers for the records, in order
 };
 
+/// \brief The still plane an object stands on, as the front end found it.
+struct SupportPlane {
+  Eigen::Vector4d plane = Eigen::Vector4d(0.0, 0.0, 1.0, 0.0);  ///< n·p + d = 0, n unit [m]
+  Eigen::Vector3f chroma = Eigen::Vector3f::Constant(1.0f / 3.0f);  ///< its mean colour / (R + G + B)
+};
+
 /**
  * \brief What the front end found of the object in the previous frame, for a
- *        pose source: its supervoxels' centroids in that frame's camera.
- *        Odometry leaves out what is nearer than the object (hands) and tells
- *        whether the scene apart from the object fixes the camera's motion.
+ *        pose source: its supervoxels' centroids and the plane it stands on,
+ *        in that frame's camera. Odometry leaves out what is nearer than the
+ *        object but off the plane (hands) and tells whether the scene apart
+ *        from the object fixes the camera's motion.
  */
 struct ObjectHint {
   /// [m], 3 x N; empty before the object is found or when it was lost.
   Eigen::Matrix3Xd points_c = Eigen::Matrix3Xd(3, 0);
+  /// The plane it stands on, when the front end found one.
+  std::optional<SupportPlane> plane_c;
 
   /// \brief The nearest depth (the smallest Z) [m]; none without points.
   [[nodiscard]] std::optional<double> nearest_depth() const {
@@ -59,10 +68,18 @@ struct ObjectHint {
  *        supervoxels, seen from the pose the front end used).
  * \param points_w points in the world frame [m], 3 x N.
  * \param wMc      the camera's pose (world <- camera).
+ * \param plane_w  the support plane in the world frame.
  */
-[[nodiscard]] inline ObjectHint object_hint(const Eigen::Matrix3Xd& points_w, const Eigen::Isometry3d& wMc) {
+[[nodiscard]] inline ObjectHint object_hint(const Eigen::Matrix3Xd& points_w, const Eigen::Isometry3d& wMc,
+                                            const std::optional<SupportPlane>& plane_w = std::nullopt) {
   ObjectHint hint;
   if (points_w.cols() > 0) hint.points_c = wMc.inverse() * points_w;
+  if (plane_w) {  // n_c = R^T n_w; a camera point p_c is at R p_c + t in the world
+    const Eigen::Vector3d n = plane_w->plane.head<3>();
+    hint.plane_c = plane_w;
+    hint.plane_c->plane.head<3>() = wMc.linear().transpose() * n;
+    hint.plane_c->plane(3) = n.dot(wMc.translation()) + plane_w->plane(3);
+  }
   return hint;
 }
 

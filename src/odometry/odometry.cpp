@@ -137,6 +137,19 @@ struct Odometry::Impl {
     const std::optional<double> object_depth = object.nearest_depth();
     const bool masking = settings.mask && object_depth && std::isfinite(*object_depth);
     const double nearest = masking ? *object_depth - settings.mask_margin : 0.0;
+    // The support plane is still, however near: its pixels stay in (on it
+    // and of its colour: an arm that touches the table is on it too).
+    const bool colour = frame.rgb.size() == 3 * frame.depth.size();
+    const auto on_plane = [&](int u, int v, float z) {
+      if (!object.plane_c) return false;
+      const Eigen::Vector4d& plane = object.plane_c->plane;
+      const Eigen::Vector3d p((u - intrinsics.cx) / intrinsics.fx * z, (v - intrinsics.cy) / intrinsics.fy * z, z);
+      if (std::abs(plane.head<3>().dot(p) + plane(3)) > settings.mask_plane_distance) return false;
+      if (!colour) return true;
+      const std::uint8_t* c = &frame.rgb[3 * frame.index(factor * u, factor * v)];
+      const Eigen::Vector3f rgb(c[0], c[1], c[2]);
+      return (rgb / std::max(rgb.sum(), 1.0f) - object.plane_c->chroma).norm() <= settings.mask_plane_chroma;
+    };
     long used = 0;
     long masked = 0;
     for (int v = 0; v < h; ++v) {
@@ -146,7 +159,7 @@ struct Odometry::Impl {
         const float z = frame.depth[frame.index(factor * u, factor * v)];
         const bool valid = z >= settings.min_depth && z <= settings.max_depth;  // NaN fails
         drow[u] = valid ? z : nan;
-        const bool hidden = valid && masking && z < nearest;
+        const bool hidden = valid && masking && z < nearest && !on_plane(u, v, z);
         mrow[u] = valid && !hidden ? 255 : 0;
         used += valid && !hidden ? 1 : 0;
         masked += hidden ? 1 : 0;

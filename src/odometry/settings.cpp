@@ -98,10 +98,17 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                 "every 2nd (3rd, ...) pixel of every 2nd row (0: at their own size)",
                 0, 100000);
     bool_row(t, "mask", &S::mask,
-             "leave out pixels nearer than the object's depth in the previous frame minus mask_margin (hands, "
-             "occluders)");
+             "leave out pixels nearer than the object's depth in the previous frame minus mask_margin, but not "
+             "those on the plane it stands on (hands, occluders)");
     number_row(t, "mask_margin", &S::mask_margin, "m",
                "see mask: how much nearer than the object a pixel must be to be left out", 0.0, 10.0, false);
+    number_row(t, "mask_plane_distance", &S::mask_plane_distance, "m",
+               "see mask: pixels within this of the object's support plane stay in (the table is still) ...", 0.0,
+               1.0, false);
+    number_row(t, "mask_plane_chroma", &S::mask_plane_chroma, "",
+               "... when their chromaticity (R, G, B over their sum) is within this of the plane's (in colour "
+               "frames: an arm on the table is on its plane too)",
+               0.0, 2.0, false);
     number_row(t, "min_still_constraint", &S::min_still_constraint, "",
                "a step is degenerate (the pose stays) when the scene apart from the object, or the part that "
                "matches the reference, fixes the camera's translation less than this: the smallest eigenvalue of "

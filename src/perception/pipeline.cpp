@@ -89,6 +89,7 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
     previous.intrinsics = frame.intrinsics;
     previous.wMc = frame.wMc;
   }
+  if (plane) r.support_plane = SupportPlane{*plane, plane_chroma};
   r.timings.total = ms_since(start);
   return r;
 }

@@ -12,6 +12,7 @@ namespace ofv::perception {
 Observation observation(const PerceptionResult& result, double voxel) {
   Observation o;
   o.wMc = result.wMc;
+  o.support_plane = result.support_plane;
   if (result.status == TrackingStatus::Lost) return o;
   // The occluders beyond the image border come last (classify, then beyond_view).
   const Eigen::Index all = result.problem.occluders.cols();

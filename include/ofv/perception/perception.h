@@ -314,6 +314,9 @@ struct PerceptionResult {
       Eigen::Matrix3d::Identity();  ///< e1, e2, e3 (columns), PCA of the object voxels
   OrientedBox obb;                  ///< the augmented OBB
   Eigen::Isometry3d wMc = Eigen::Isometry3d::Identity();  ///< pose of the camera that saw the frame
+  /// The support plane (world frame) the first frame's selection fitted,
+  /// and its colour; none before it, or when it found none.
+  std::optional<SupportPlane> support_plane;
   /// The remembered object voxels this frame does not show (behind
   /// something, out of the image, presumed behind an occluder) [m].
   std::vector<Eigen::Vector3f> hidden;
