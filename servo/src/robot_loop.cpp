@@ -224,7 +224,9 @@ RobotLoopSummary run_on_robot(FrameSource& source, Observer& observer, CameraRob
       observation.wMc = pose ? pose->wMc : frame->wMc;
       observation.pose = !pose || pose->ok ? PoseStatus::Known : PoseStatus::Unknown;
       out.pose = pose ? &*pose : nullptr;
-      object = observation.problem ? object_hint(observation.problem->positions, observation.wMc, observation.support_plane) : ObjectHint{};
+      object = observation.problem
+                   ? object_hint(observation.problem->positions, observation.wMc, observation.support_plane)
+                   : ObjectHint{};
       out.perception_s = std::chrono::duration<double>(Clock::now() - arrived).count();
       observation.age = out.frame_age = options.wall_clock_age ? out.perception_s : gap;
       out.observation = &observation;

@@ -129,11 +129,10 @@ struct OdometrySettings {
   /// Leave out pixels nearer than the object's depth minus mask_margin but
   /// not on its support plane (within mask_plane_distance of it, of its
   /// colour), when the caller gives them (ObjectHint): hands in front of the
-  /// object. Without
-  /// the plane the table running towards the camera was left out too, and
-  /// the turn about the optical axis of a camera facing a case was fixed by
-  /// the case's sides alone: 0.10-0.17 deg of error per frame on dvd-static,
-  /// 0.01 deg with the table (docs/perception.md).
+  /// object. Without the plane the table running towards the camera was left
+  /// out too, and the turn about the optical axis of a camera facing a case
+  /// was fixed by the case's sides alone: 0.10-0.17 deg of error per frame on
+  /// dvd-static, 0.01 deg with the table (docs/perception.md).
   bool mask = true;
   double mask_margin = 0.10;  ///< [m] see `mask`: the hands and occluders in front of the object
   double mask_plane_distance = 0.01;  ///< [m] see `mask`: pixels this near the support plane stay in ...

@@ -467,8 +467,9 @@ EpisodeOutcome run_episode(const EpisodeSetup& setup, const StepObserver& observ
         observation = perception->observe(rendered.frame);
         observation->pose = !pose || pose->ok ? PoseStatus::Known : PoseStatus::Unknown;
         rec.times.perception = seconds_since(start);
-        object = observation->problem ? object_hint(observation->problem->positions, observation->wMc,
-                                                            observation->support_plane) : ObjectHint{};
+        object = observation->problem
+                     ? object_hint(observation->problem->positions, observation->wMc, observation->support_plane)
+                     : ObjectHint{};
         rec.perception = score(rendered.frame, perception->last(), renderer, front_end);
       } else {
         observation = truth_observation(rendered.frame, std::move(gt_problem), front_end);
