@@ -252,11 +252,13 @@ struct Odometry::Impl {
 
   /// Of the used pixels of `src` (sampled) whose point, moved by `motion`
   /// (kMc), falls on a used pixel of the reference (the overlap: in view, depth
-  /// in range, not masked there), those within max_depth_diff of it; and
-  /// their RMS difference. What the reference did not use (it left the view,
-  /// was masked there or hidden) tells nothing of the motion: counted as
-  /// mismatches, the check failed a right motion whenever the mask changed
-  /// (the object lost, no mask) or the camera saw past the occluders.
+  /// in range, not masked there) and, with occlusion_aware, not behind what
+  /// the reference saw there by more than max_depth_diff, those within
+  /// max_depth_diff of it; and their RMS difference. What the reference did
+  /// not see (it left the view, was masked there or hidden) tells nothing of
+  /// the motion: counted as mismatches, the check failed a right motion
+  /// whenever the mask changed (the object lost, no mask), the camera saw
+  /// past the occluders or, in no-free-view's cage, moved along its bars.
   /// `matching` gets the pixels around the matching samples.
   void inliers(const cv::rgbd::OdometryFrame& src, const cv::rgbd::OdometryFrame& ref, const Eigen::Isometry3d& motion,
                OdometryDiagnostics& d, cv::Mat& matching) const {
@@ -284,8 +286,12 @@ struct Odometry::Impl {
         const long vi = std::lround(vq);
         if (!(ui >= 0 && ui < k.width && vi >= 0 && vi < k.height)) continue;
         if (ref.mask.at<std::uint8_t>(static_cast<int>(vi), static_cast<int>(ui)) == 0) continue;
-        ++samples;
         const double diff = ref.depth.at<float>(static_cast<int>(vi), static_cast<int>(ui)) - q.z();
+        // A point behind what the reference saw there was hidden from it:
+        // no evidence either way (thin near bars hide much of the scene
+        // from one frame to the next). One in front of it contradicts it.
+        if (settings.occlusion_aware && diff < -settings.max_depth_diff) continue;
+        ++samples;
         if (std::abs(diff) <= settings.max_depth_diff) {
           ++matched;
           sum += diff * diff;

@@ -74,6 +74,9 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                "a step after which fewer of the used pixels that fall on pixels the reference used are within "
                "max_depth_diff of them is implausible",
                0.0, 1.0, false);
+    bool_row(t, "occlusion_aware", &S::occlusion_aware,
+             "min_overlap_fraction and min_inlier_fraction leave out the pixels that fall behind what the reference "
+             "saw there by more than max_depth_diff (hidden from it; false: count them as mismatches)");
     number_row(t, "max_residual_ratio", &S::max_residual_ratio, "",
                "a step after which the pixels that match the reference differ from it (RMS) by more than this "
                "times the median of the last 9 ok steps' is implausible: one surface taken for another (0: never)",

@@ -97,6 +97,9 @@ struct OdometrySettings {
   /// implausible, too little to judge the match by.
   double min_overlap_fraction = 0.02;
   double min_inlier_fraction = 0.6;    ///< fewer of the used pixels that fall on the reference's matching it after the motion: implausible
+  /// Leave out of the overlap the pixels that fall behind what the reference
+  /// saw there (hidden from it), counting as mismatches only those in front.
+  bool occlusion_aware = true;
   /// A step whose matching pixels differ from the reference (RMS,
   /// OdometryDiagnostics::residual) by more than this times the median of
   /// the last 9 Ok steps' is implausible (0: never; with 3 Ok steps or more).
