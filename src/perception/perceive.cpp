@@ -63,7 +63,9 @@ PerceiveSummary perceive(FrameSource& source, const PerceptionSettings& ps,
     }
     bad_frames.good();
     f.index = summary.frames;
-    object = f.result.status != TrackingStatus::Lost ? object_hint(f.result.problem.positions, f.frame.wMc, f.result.support_plane) : ObjectHint{};
+    object = f.result.status != TrackingStatus::Lost
+                 ? object_hint(f.result.problem.positions, f.frame.wMc, f.result.support_plane)
+                 : ObjectHint{};
     front_end_ms.push_back(f.result.timings.total);
     if (f.result.status != TrackingStatus::Lost) {
       f.result.problem.previous_view = previous_view;
