@@ -135,17 +135,24 @@ class VoxelContacts {
   /// itself too).
   template <typename F>
   void for_each(std::size_t x, F&& f) const {
+    for_each_pair(x, [&](std::size_t y, const Eigen::Vector3f&, const Eigen::Vector3f&) { f(y); });
+  }
+
+  /// Calls f(y, p, q) for every voxel p of x and q of a kept supervoxel y
+  /// within the distance of each other.
+  template <typename F>
+  void for_each_pair(std::size_t x, F&& f) const {
     for (int m = first_[x]; m < first_[x + 1]; ++m) {
       const Eigen::Vector3f& p = points_[static_cast<std::size_t>(m)];
       grid_.for_each_near(p, [&](int j) {
-        if ((points_[static_cast<std::size_t>(j)] - p).squaredNorm() <= radius2_) {
-          f(static_cast<std::size_t>(owners_[static_cast<std::size_t>(j)]));
-        }
+        const Eigen::Vector3f& q = points_[static_cast<std::size_t>(j)];
+        if ((q - p).squaredNorm() <= radius2_) f(static_cast<std::size_t>(owners_[static_cast<std::size_t>(j)]), p, q);
       });
     }
   }
 
  private:
+
   float radius2_ = 0.0f;
   std::vector<Eigen::Vector3f> points_;  // the kept voxels, grouped by supervoxel
   std::vector<int> owners_;              // the supervoxel of each
@@ -186,6 +193,10 @@ struct Perception::Impl {
   // never become object and cannot pull their neighbours in next frame.
   std::vector<char> voxel_matched;
   std::vector<char> voxel_revealed;  // revealed object surface (grow_revealed()), remembered
+  // Per voxel of the current frame that track() matched: the chromaticity
+  // of the memory voxel it matched, which it is remembered with (empty:
+  // every voxel is remembered with its own).
+  std::vector<Eigen::Vector3f> voxel_anchor;
   detail::VoxelContacts contacts;    // grow_revealed(), classify(): which supervoxels come near one another
   // object_motion(): the frame's object voxels (hashed), normals and
   // chromaticities, and the voxels on the object's own outline with the
@@ -284,12 +295,16 @@ struct Perception::Impl {
   std::vector<char> labelled_object(const RgbdFrame& frame, const PerceptionResult& r);
   /// object_memory.cpp: a later frame's object supervoxels, those near the
   /// remembered object voxels; sets voxel_matched.
-  std::vector<char> track(const PerceptionResult& r);
-  /// True if a memory voxel of chromaticity c (within max_chroma_distance)
-  /// lies within radius (<= the cell of `grid`, built on `memory`) of p.
-  [[nodiscard]] bool remembered_near(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const;
+  std::vector<char> track(const RgbdFrame& frame, const PerceptionResult& r);
+  /// The nearest memory voxel of chromaticity c (within max_chroma_distance)
+  /// within radius (<= the cell of `grid`, built on `memory`) of p; -1: none.
+  [[nodiscard]] int remembered_match(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const;
+  [[nodiscard]] bool remembered_near(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const {
+    return remembered_match(p, radius, c) >= 0;
+  }
   /// Grows `object` over surface the previous frame could not see (TrackingSettings::grow_revealed).
-  void grow_revealed(const PerceptionResult& r, const std::vector<int>& near, std::vector<char>& object);
+  void grow_revealed(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<int>& near,
+                     std::vector<char>& object);
   /// pipeline.cpp: r.status and r.message from the object found; the first
   /// frame found also sets the state's start (initialised, initial_voxels).
   void set_status(const RgbdFrame& frame, PerceptionResult& r, const std::vector<char>& object, std::string why);

@@ -23,21 +23,45 @@ namespace {
 /// A surface facing a camera at less than this cosine (17 degrees from
 /// edge-on) gives it too few and too noisy pixels to be told apart.
 constexpr double kGrazing = 0.3;
+
+/// Nearest of `points` (hashed in `grid`, cells >= radius) to p within
+/// radius that has accept(j); -1 when none.
+template <typename Accept>
+int nearest(const detail::PointGrid& grid, const std::vector<Eigen::Vector3f>& points,
+            const Eigen::Vector3f& p, float radius, Accept&& accept) {
+  int best = -1;
+  float best_d2 = radius * radius;
+  grid.for_each_near(p, [&](int j) {
+    const float d2 = (points[static_cast<std::size_t>(j)] - p).squaredNorm();
+    if (d2 <= best_d2 && accept(j)) {
+      best_d2 = d2;
+      best = j;
+    }
+  });
+  return best;
+}
 }  // namespace
 
-std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
+std::vector<char> Perception::Impl::track(const RgbdFrame& frame, const PerceptionResult& r) {
   const std::size_t n = r.supervoxels.size();
   const TrackingSettings& t = settings.tracking;
   grid.build(memory, t.max_motion);
   std::vector<int> near(n, 0);
   voxel_matched.assign(r.voxels.size(), 0);
+  voxel_anchor.resize(r.voxels.size());
   const auto radius = static_cast<float>(t.max_motion);
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
-    const bool is_near = !plane_voxel(r.voxels[i], sv.colours[i]) &&
-                         remembered_near(r.voxels[i], radius, chroma(sv.colours[i]));
-    near[owner] += is_near ? 1 : 0;
-    voxel_matched[i] = is_near ? 1 : 0;
+    const int match = plane_voxel(r.voxels[i], sv.colours[i])
+                          ? -1
+                          : remembered_match(r.voxels[i], radius, chroma(sv.colours[i]));
+    near[owner] += match >= 0 ? 1 : 0;
+    voxel_matched[i] = match >= 0 ? 1 : 0;
+    // Remembered with the chromaticity it matched, not its own: a voxel
+    // mixing the object's colour with a touching hand's may match, but
+    // cannot carry the match a step further towards the hand's colour in
+    // the next frame (cloth-fold: step by step, the whole hand joined).
+    if (match >= 0) voxel_anchor[i] = memory_chroma[static_cast<std::size_t>(match)];
   }
   std::vector<char> object(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -48,18 +72,18 @@ std::vector<char> Perception::Impl::track(const PerceptionResult& r) {
             ? 1
             : 0;
   }
-  if (t.grow_revealed) grow_revealed(r, near, object);
+  if (t.grow_revealed) grow_revealed(frame, r, near, object);
   return object;
 }
 
-bool Perception::Impl::remembered_near(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const {
+int Perception::Impl::remembered_match(const Eigen::Vector3f& p, float radius, const Eigen::Vector3f& c) const {
   const auto max_chroma = static_cast<float>(settings.tracking.max_chroma_distance);
-  return grid.any_within(p, radius, [&](int j) {
+  return nearest(grid, memory, p, radius, [&](int j) {
     return max_chroma <= 0.0f || (memory_chroma[static_cast<std::size_t>(j)] - c).norm() <= max_chroma;
   });
 }
 
-void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vector<int>& near,
+void Perception::Impl::grow_revealed(const RgbdFrame& frame, const PerceptionResult& r, const std::vector<int>& near,
                                      std::vector<char>& object) {
   if (previous.depth.empty()) return;
   const TrackingSettings& t = settings.tracking;
@@ -133,6 +157,14 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
                  [&](std::size_t j) { return !on_plane(r.supervoxels[j]); });
   const double per_side = settings.supervoxels.seed_resolution / settings.supervoxels.voxel_resolution;
   const int cell_face = std::max(1, static_cast<int>(per_side * per_side));  // voxels on a seed cell's face
+  const Eigen::Isometry3d frame_cMw = frame.wMc.inverse();
+  const auto gap_seen = [&](const Eigen::Vector3f& p, const Eigen::Vector3f& q) {
+    for (const float s : {0.25f, 0.5f, 0.75f}) {
+      const auto l = detail::look(frame, frame_cMw, (p + s * (q - p)).cast<double>());
+      if (l && l->measured() && static_cast<double>(l->observed) > l->z + settings.contact_distance) return true;
+    }
+    return false;
+  };
   const auto seen_not_object = [&](std::size_t j) {
     return 2 * seen_before[j] > r.supervoxels[j].voxel_count && near[j] == 0;
   };
@@ -161,18 +193,22 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
         seen_surface = seen_surface || count >= cell_face;
       }
       contacts.for_each(x, [&](std::size_t y) {
-        if (!alike(x, y)) return;
-        if (object[y]) {
-          // Touching the object where the object is of this colour (its
-          // memory there): an object supervoxel at its border can mix its
-          // colour with what touches it, and through it a hand's sides,
-          // edge-on to the previous frame, joined the object (cloth-fold).
-          touches = touches ||
-                    remembered_near(r.supervoxels[y].centroid.cast<float>(), radius, chroma(r.supervoxels[x].colour));
-        } else if (component[y] < 0) {
+        if (!object[y] && component[y] < 0 && alike(x, y)) {
           component[y] = id;
           open.push_back(y);
         }
+      });
+      // Touching the object: a voxel within R_adj of an object voxel where
+      // the object is of this colour (its memory there: an object
+      // supervoxel at its border can mix its colour with what touches it,
+      // and through it a hand's sides, edge-on to the previous frame,
+      // joined the object: cloth-fold), with no empty space seen between
+      // the two (the frame shows what lies behind the gap: a box of the
+      // object's colour a few centimetres beside it is not its
+      // continuation).
+      contacts.for_each_pair(x, [&](std::size_t y, const Eigen::Vector3f& p, const Eigen::Vector3f& q) {
+        touches = touches || (object[y] && alike(x, y) &&
+                              remembered_near(q, radius, chroma(r.supervoxels[x].colour)) && !gap_seen(p, q));
       });
     }
     const bool ambiguous = seen_surface || 4 * seen_voxels >= voxels;
@@ -197,23 +233,6 @@ void Perception::Impl::grow_revealed(const PerceptionResult& r, const std::vecto
 }
 
 namespace {
-
-/// Nearest of `points` (hashed in `grid`, cells >= radius) to p within
-/// radius that has accept(j); -1 when none.
-template <typename Accept>
-int nearest(const detail::PointGrid& grid, const std::vector<Eigen::Vector3f>& points,
-            const Eigen::Vector3f& p, float radius, Accept&& accept) {
-  int best = -1;
-  float best_d2 = radius * radius;
-  grid.for_each_near(p, [&](int j) {
-    const float d2 = (points[static_cast<std::size_t>(j)] - p).squaredNorm();
-    if (d2 <= best_d2 && accept(j)) {
-      best_d2 = d2;
-      best = j;
-    }
-  });
-  return best;
-}
 
 /// The plane of points `d` (mean, unit normal): least squares, refitted
 /// three times to the points within `inlier` of the last fit, so that the
@@ -452,7 +471,7 @@ void Perception::Impl::remember(const RgbdFrame& frame, PerceptionResult& r,
     if ((object[owner] && voxel_matched[i]) || voxel_revealed[i]) {
       const SupervoxelInfo& s = r.supervoxels[owner];
       next.push_back(r.voxels[i]);
-      next_chroma.push_back(chroma(sv.colours[i]));
+      next_chroma.push_back(voxel_matched[i] && !voxel_anchor.empty() ? voxel_anchor[i] : chroma(sv.colours[i]));
       next_age.push_back(0);
       next_normal.push_back(s.normal_valid ? Eigen::Vector3f(s.normal.cast<float>())
                                            : Eigen::Vector3f::Zero());

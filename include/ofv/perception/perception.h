@@ -79,6 +79,9 @@ struct TrackingSettings {
   /// has a chromaticity similar to its own (R, G, B over their sum, so shading does not
   /// matter): Euclidean distance at most this. Keeps the table under the
   /// object and a touching hand of another colour out; <= 0 turns it off.
+  /// A matched voxel is remembered with the chromaticity it matched, so a
+  /// voxel mixing two colours cannot lead the next frame's match a step
+  /// further towards a touching hand's.
   double max_chroma_distance = 0.06;
   /// The object is lost when fewer of its voxels than this fraction of what
   /// the view can show are found: the first frame's count, or fewer where
@@ -126,7 +129,9 @@ struct TrackingSettings {
   /// otherwise — beyond its image (an object the first image cut) or facing
   /// its camera at less than 17 degrees from edge-on (the top of a box the
   /// camera rises over) — counts the same way when its supervoxel is linked
-  /// through surface of its colour to the object. false: only what lies
+  /// through surface of its colour to the object, within R_adj of an object
+  /// voxel of that colour with no empty space seen between the two (a body
+  /// of the object's colour beside it is not its continuation). false: only what lies
   /// within max_motion of the remembered object (the paper's assumption 2).
   bool grow_revealed = true;
   /// Dominant plane (RANSAC on the first frame, at least a fifth of its
