@@ -152,7 +152,6 @@ class VoxelContacts {
   }
 
  private:
-
   float radius2_ = 0.0f;
   std::vector<Eigen::Vector3f> points_;  // the kept voxels, grouped by supervoxel
   std::vector<int> owners_;              // the supervoxel of each
