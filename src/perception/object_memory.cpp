@@ -192,23 +192,23 @@ void Perception::Impl::grow_revealed(const RgbdFrame& frame, const PerceptionRes
         seen_voxels += count;
         seen_surface = seen_surface || count >= cell_face;
       }
-      contacts.for_each(x, [&](std::size_t y) {
-        if (!object[y] && component[y] < 0 && alike(x, y)) {
+      contacts.for_each_pair(x, [&](std::size_t y, const Eigen::Vector3f& p, const Eigen::Vector3f& q) {
+        if (!alike(x, y)) return;
+        if (object[y]) {
+          // Touching the object: a voxel within R_adj of an object voxel
+          // where the object is of this colour (its memory there: an object
+          // supervoxel at its border can mix its colour with what touches
+          // it, and through it a hand's sides, edge-on to the previous
+          // frame, joined the object: cloth-fold), with no empty space seen
+          // between the two (the frame shows what lies behind the gap: a box
+          // of the object's colour a few centimetres beside it is not its
+          // continuation).
+          touches = touches ||
+                    (remembered_near(q, radius, chroma(r.supervoxels[x].colour)) && !gap_seen(p, q));
+        } else if (component[y] < 0) {
           component[y] = id;
           open.push_back(y);
         }
-      });
-      // Touching the object: a voxel within R_adj of an object voxel where
-      // the object is of this colour (its memory there: an object
-      // supervoxel at its border can mix its colour with what touches it,
-      // and through it a hand's sides, edge-on to the previous frame,
-      // joined the object: cloth-fold), with no empty space seen between
-      // the two (the frame shows what lies behind the gap: a box of the
-      // object's colour a few centimetres beside it is not its
-      // continuation).
-      contacts.for_each_pair(x, [&](std::size_t y, const Eigen::Vector3f& p, const Eigen::Vector3f& q) {
-        touches = touches || (object[y] && alike(x, y) &&
-                              remembered_near(q, radius, chroma(r.supervoxels[x].colour)) && !gap_seen(p, q));
       });
     }
     const bool ambiguous = seen_surface || 4 * seen_voxels >= voxels;

@@ -71,7 +71,8 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   std::string why;
   voxel_revealed.assign(r.voxels.size(), 0);  // only track() finds revealed surface
   voxel_anchor.clear();                         // nor matches a remembered chromaticity
-  const std::vector<char> object = labelled ? labelled_object(frame, r) : initialised ? track(frame, r) : select(frame, r, why);
+  const std::vector<char> object =
+      labelled ? labelled_object(frame, r) : initialised ? track(frame, r) : select(frame, r, why);
   set_status(frame, r, object, why);
   if (r.status != TrackingStatus::Lost) {
     remember(frame, r, object);
