@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <string>
@@ -37,10 +38,16 @@ struct FramePose {
   std::vector<std::pair<std::string, double>> diagnostics;  ///< numbers for the records, in order
 };
 
+/// \brief Colour without brightness: R, G, B over their sum (shading-invariant;
+///        black stays black). The front end's colour tests and SupportPlane::chroma use it.
+[[nodiscard]] inline Eigen::Vector3f chromaticity(const Eigen::Vector3f& rgb) {
+  return rgb / std::max(rgb.sum(), 1.0f);
+}
+
 /// \brief The still plane an object stands on, as the front end found it.
 struct SupportPlane {
   Eigen::Vector4d plane = Eigen::Vector4d(0.0, 0.0, 1.0, 0.0);  ///< n·p + d = 0, n unit [m]
-  Eigen::Vector3f chroma = Eigen::Vector3f::Constant(1.0f / 3.0f);  ///< its mean colour / (R + G + B)
+  Eigen::Vector3f chroma = Eigen::Vector3f::Constant(1.0f / 3.0f);  ///< its mean chromaticity()
 };
 
 /**

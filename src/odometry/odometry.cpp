@@ -148,7 +148,7 @@ struct Odometry::Impl {
       if (!colour) return true;
       const std::uint8_t* c = &frame.rgb[3 * frame.index(factor * u, factor * v)];
       const Eigen::Vector3f rgb(c[0], c[1], c[2]);
-      return (rgb / std::max(rgb.sum(), 1.0f) - object.plane_c->chroma).norm() <= settings.mask_plane_chroma;
+      return (chromaticity(rgb) - object.plane_c->chroma).norm() <= settings.mask_plane_chroma;
     };
     long used = 0;
     long masked = 0;

@@ -30,14 +30,9 @@ namespace ofv::perception {
 
 namespace detail {
 
-/// Colour without brightness: R, G, B over their sum (shading-invariant).
-inline Eigen::Vector3f chroma(const Eigen::Vector3f& rgb) {
-  return rgb / std::max(rgb.sum(), 1.0f);
-}
-
 /// Two colours alike: their chromaticities within max_chroma (<= 0: any).
 inline bool alike(const Eigen::Vector3f& a, const Eigen::Vector3f& b, double max_chroma) {
-  return max_chroma <= 0.0 || static_cast<double>((chroma(a) - chroma(b)).norm()) <= max_chroma;
+  return max_chroma <= 0.0 || static_cast<double>((chromaticity(a) - chromaticity(b)).norm()) <= max_chroma;
 }
 
 /// Pixel of world point p in the frame's camera; nullopt behind the camera.
@@ -257,7 +252,7 @@ struct Perception::Impl {
            std::abs(plane->head<3>().cast<float>().dot(p) + static_cast<float>((*plane)(3))) <=
                static_cast<float>(settings.tracking.plane_distance) &&
            (settings.tracking.max_chroma_distance <= 0.0 ||
-            (detail::chroma(rgb) - plane_chroma).norm() <=
+            (chromaticity(rgb) - plane_chroma).norm() <=
                 static_cast<float>(settings.tracking.max_chroma_distance));
   }
 

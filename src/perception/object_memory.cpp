@@ -17,8 +17,6 @@
 
 namespace ofv::perception {
 
-using detail::chroma;
-
 namespace {
 /// A surface facing a camera at less than this cosine (17 degrees from
 /// edge-on) gives it too few and too noisy pixels to be told apart.
@@ -54,7 +52,7 @@ std::vector<char> Perception::Impl::track(const RgbdFrame& frame, const Percepti
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     const int match = plane_voxel(r.voxels[i], sv.colours[i])
                           ? -1
-                          : remembered_match(r.voxels[i], radius, chroma(sv.colours[i]));
+                          : remembered_match(r.voxels[i], radius, chromaticity(sv.colours[i]));
     near[owner] += match >= 0 ? 1 : 0;
     voxel_matched[i] = match >= 0 ? 1 : 0;
     // Remembered with the chromaticity it matched, not its own: a voxel
@@ -116,7 +114,7 @@ void Perception::Impl::grow_revealed(const RgbdFrame& frame, const PerceptionRes
     const double d = l ? static_cast<double>(l->observed) : 0.0;
     if (l && d < l->z - t.max_motion) {
       const Eigen::Vector3f hider = detail::unproject(previous, l->u, l->v, d).cast<float>();
-      if (remembered_near(hider, res, chroma(sv.colours[i]))) {
+      if (remembered_near(hider, res, chromaticity(sv.colours[i]))) {
         voxel_state[i] = 1;
         ++revealed[owner];
       }
@@ -204,7 +202,7 @@ void Perception::Impl::grow_revealed(const RgbdFrame& frame, const PerceptionRes
           // of the object's colour a few centimetres beside it is not its
           // continuation).
           touches = touches ||
-                    (remembered_near(q, radius, chroma(r.supervoxels[x].colour)) && !gap_seen(p, q));
+                    (remembered_near(q, radius, chromaticity(r.supervoxels[x].colour)) && !gap_seen(p, q));
         } else if (component[y] < 0) {
           component[y] = id;
           open.push_back(y);
@@ -276,7 +274,7 @@ Eigen::Isometry3d Perception::Impl::object_motion(const RgbdFrame& frame,
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
     if (object[owner] && voxel_matched[i]) {
       moved.push_back(r.voxels[i]);
-      moved_chroma.push_back(chroma(sv.colours[i]));
+      moved_chroma.push_back(chromaticity(sv.colours[i]));
       moved_normals.push_back(r.supervoxels[owner].normal_valid
                                   ? Eigen::Vector3f(r.supervoxels[owner].normal.cast<float>())
                                   : Eigen::Vector3f::Zero());
@@ -471,7 +469,7 @@ void Perception::Impl::remember(const RgbdFrame& frame, PerceptionResult& r,
     if ((object[owner] && voxel_matched[i]) || voxel_revealed[i]) {
       const SupervoxelInfo& s = r.supervoxels[owner];
       next.push_back(r.voxels[i]);
-      next_chroma.push_back(voxel_matched[i] && !voxel_anchor.empty() ? voxel_anchor[i] : chroma(sv.colours[i]));
+      next_chroma.push_back(voxel_matched[i] && !voxel_anchor.empty() ? voxel_anchor[i] : chromaticity(sv.colours[i]));
       next_age.push_back(0);
       next_normal.push_back(s.normal_valid ? Eigen::Vector3f(s.normal.cast<float>())
                                            : Eigen::Vector3f::Zero());

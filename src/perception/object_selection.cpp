@@ -14,8 +14,6 @@ namespace ofv::perception {
 
 namespace {
 
-using detail::chroma;
-
 /// Clusters of the supervoxels with keep[i] of one colour: neighbours join,
 /// nearest in chromaticity first, when the two clusters' mean chromaticities
 /// (weighted by voxels) are within max_chroma (any two when max_chroma <= 0).
@@ -32,7 +30,7 @@ std::vector<std::vector<int>> colour_clusters(const std::vector<SupervoxelInfo>&
   for (std::size_t i = 0; i < n; ++i) {
     parent[i] = static_cast<int>(i);
     weight[i] = static_cast<float>(std::max(supervoxels[i].voxel_count, 1));
-    chroma_sum[i] = weight[i] * chroma(supervoxels[i].colour);
+    chroma_sum[i] = weight[i] * chromaticity(supervoxels[i].colour);
   }
   const auto find = [&parent](int i) {
     while (parent[static_cast<std::size_t>(i)] != i) {
@@ -48,8 +46,8 @@ std::vector<std::vector<int>> colour_clusters(const std::vector<SupervoxelInfo>&
   std::vector<Edge> edges;
   for (const auto& [a, b] : neighbours) {
     if (!keep[static_cast<std::size_t>(a)] || !keep[static_cast<std::size_t>(b)]) continue;
-    edges.push_back({(chroma(supervoxels[static_cast<std::size_t>(a)].colour) -
-                      chroma(supervoxels[static_cast<std::size_t>(b)].colour))
+    edges.push_back({(chromaticity(supervoxels[static_cast<std::size_t>(a)].colour) -
+                      chromaticity(supervoxels[static_cast<std::size_t>(b)].colour))
                          .norm(),
                      std::min(a, b), std::max(a, b)});
   }
@@ -130,7 +128,7 @@ void grow_into_boundary(const std::vector<SupervoxelInfo>& supervoxels,
   const std::size_t n = supervoxels.size();
   Eigen::Vector3f object_chroma = Eigen::Vector3f::Zero();
   for (int i : cluster) {
-    object_chroma += chroma(supervoxels[static_cast<std::size_t>(i)].colour);
+    object_chroma += chromaticity(supervoxels[static_cast<std::size_t>(i)].colour);
   }
   object_chroma /= static_cast<float>(cluster.size());
   const auto limit = static_cast<float>(max_chroma);
@@ -138,7 +136,7 @@ void grow_into_boundary(const std::vector<SupervoxelInfo>& supervoxels,
   std::vector<int> foreign_count(n, 0);
   for (const auto& [a, b] : neighbours) {
     for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}}) {
-      const Eigen::Vector3f cy = chroma(supervoxels[static_cast<std::size_t>(y)].colour);
+      const Eigen::Vector3f cy = chromaticity(supervoxels[static_cast<std::size_t>(y)].colour);
       if ((cy - object_chroma).norm() > limit) {
         foreign_sum[static_cast<std::size_t>(x)] += cy;
         ++foreign_count[static_cast<std::size_t>(x)];
@@ -153,7 +151,7 @@ void grow_into_boundary(const std::vector<SupervoxelInfo>& supervoxels,
         if (object[xi] || !object[static_cast<std::size_t>(y)] || !off_plane[xi]) {
           continue;
         }
-        const Eigen::Vector3f c = chroma(supervoxels[xi].colour);
+        const Eigen::Vector3f c = chromaticity(supervoxels[xi].colour);
         const bool nearer_object =
             foreign_count[xi] == 0
                 ? (c - object_chroma).norm() <= limit
@@ -279,7 +277,7 @@ void Perception::Impl::fit_support_plane(const RgbdFrame& frame, const Perceptio
     int count = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (on_plane(r.supervoxels[i])) {
-        sum += chroma(r.supervoxels[i].colour);
+        sum += chromaticity(r.supervoxels[i].colour);
         ++count;
       }
     }
@@ -337,10 +335,10 @@ std::vector<char> Perception::Impl::select(const RgbdFrame& frame, const Percept
   voxel_matched.resize(r.voxels.size());
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
-    const Eigen::Vector3f c = chroma(sv.colours[i]);
-    const float own = (chroma(r.supervoxels[owner].colour) - c).norm();
+    const Eigen::Vector3f c = chromaticity(sv.colours[i]);
+    const float own = (chromaticity(r.supervoxels[owner].colour) - c).norm();
     const bool foreign_colour = std::any_of(foreign[owner].begin(), foreign[owner].end(), [&](int f) {
-      return (chroma(r.supervoxels[static_cast<std::size_t>(f)].colour) - c).norm() < own;
+      return (chromaticity(r.supervoxels[static_cast<std::size_t>(f)].colour) - c).norm() < own;
     });
     voxel_matched[i] = !plane_voxel(r.voxels[i], sv.colours[i]) && !foreign_colour ? 1 : 0;
   }
