@@ -407,7 +407,7 @@ SupportPlane table_of(const RgbdFrame& f) {
       const double z = f.depth[i];
       points.push_back(f.wMc * Eigen::Vector3d((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z));
       const Eigen::Vector3f rgb(f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]);
-      chroma += rgb / rgb.sum();
+      chroma += chromaticity(rgb);
     }
   }
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
