@@ -41,22 +41,36 @@ Eigen::Isometry3d looking_at(const Eigen::Vector3d& position, const Eigen::Vecto
   return wMc;
 }
 
-// Unit directions hashed in cells `cell` wide: the directions within `cell`
-// of a point are in the 27 cells around it.
+// Unit directions in a grid of cubes `cell` wide over [-1, 1]^3: the
+// directions within `cell` of a point are in the 27 cubes around it.
 class DirectionGrid {
  public:
-  DirectionGrid(const Eigen::Matrix3Xd& d, double cell) : d_(d), cell_(std::max(cell, 1e-6)) {
-    for (int v = 0; v < static_cast<int>(d.cols()); ++v) cells_[key_of(d.col(v), 0, 0, 0)].push_back(v);
+  DirectionGrid(const Eigen::Matrix3Xd& d, double cell)
+      : d_(d), cell_(std::max(cell, 1e-6)), side_(static_cast<int>(std::floor(2.0 / cell_)) + 1) {
+    const std::size_t cubes = static_cast<std::size_t>(side_) * static_cast<std::size_t>(side_) * static_cast<std::size_t>(side_);
+    first_.assign(cubes + 1, 0);
+    std::vector<std::size_t> cube(static_cast<std::size_t>(d.cols()));
+    for (Eigen::Index v = 0; v < d.cols(); ++v) {
+      const auto q = cell_of(d.col(v));
+      cube[static_cast<std::size_t>(v)] = index_of(q[0], q[1], q[2]);
+      ++first_[cube[static_cast<std::size_t>(v)] + 1];
+    }
+    for (std::size_t c = 0; c < cubes; ++c) first_[c + 1] += first_[c];
+    members_.resize(static_cast<std::size_t>(d.cols()));
+    std::vector<int> filled(first_.begin(), first_.end() - 1);
+    for (std::size_t v = 0; v < cube.size(); ++v) members_[static_cast<std::size_t>(filled[cube[v]]++)] = static_cast<int>(v);
   }
-  // Calls f(u) for every direction u within `radius` (<= the cell) of p.
+  // Calls f(u) for every direction u within `radius` (<= the cell) of p, in
+  // the order of the cubes, then of the directions.
   template <typename F>
   void within(const Eigen::Vector3d& p, double radius, F&& f) const {
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = cells_.find(key_of(p, dx, dy, dz));
-          if (it == cells_.end()) continue;
-          for (const int u : it->second) {
+    const auto q = cell_of(p);
+    for (int x = std::max(0, q[0] - 1); x <= std::min(side_ - 1, q[0] + 1); ++x) {
+      for (int y = std::max(0, q[1] - 1); y <= std::min(side_ - 1, q[1] + 1); ++y) {
+        for (int z = std::max(0, q[2] - 1); z <= std::min(side_ - 1, q[2] + 1); ++z) {
+          const std::size_t c = index_of(x, y, z);
+          for (int k = first_[c]; k < first_[c + 1]; ++k) {
+            const int u = members_[static_cast<std::size_t>(k)];
             if ((d_.col(u) - p).norm() <= radius) f(u);
           }
         }
@@ -78,13 +92,23 @@ class DirectionGrid {
   }
 
  private:
-  [[nodiscard]] long key_of(const Eigen::Vector3d& p, int dx, int dy, int dz) const {
-    const auto q = [this](double x, int dq) { return static_cast<long>(std::floor((x + 1.0) / cell_)) + dq; };
-    return (q(p.x(), dx) * 4099L + q(p.y(), dy)) * 4099L + q(p.z(), dz);
+  [[nodiscard]] std::array<int, 3> cell_of(const Eigen::Vector3d& p) const {
+    std::array<int, 3> q{};
+    for (int a = 0; a < 3; ++a) {
+      q[static_cast<std::size_t>(a)] = std::clamp(static_cast<int>(std::floor((p[a] + 1.0) / cell_)), 0, side_ - 1);
+    }
+    return q;
+  }
+  [[nodiscard]] std::size_t index_of(int x, int y, int z) const {
+    return (static_cast<std::size_t>(x) * static_cast<std::size_t>(side_) + static_cast<std::size_t>(y)) *
+               static_cast<std::size_t>(side_) +
+           static_cast<std::size_t>(z);
   }
   const Eigen::Matrix3Xd& d_;
   double cell_;
-  std::unordered_map<long, std::vector<int>> cells_;
+  int side_;
+  std::vector<int> first_;    // cube c's directions: members_[first_[c] .. first_[c + 1])
+  std::vector<int> members_;
 };
 
 // For each direction, the directions within `chord` of it (itself first).
@@ -332,20 +356,20 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   }
 
   // States: lattice views 0..n-1, then the approach n..n+chain (n is the start).
-  // The best totals of the last K + 1 steps (K = segment steps), in turn.
   const int K = segments.k;
   const auto states = static_cast<std::size_t>(n + chain + 1);
-  std::vector<std::vector<double>> totals(static_cast<std::size_t>(K + 1), std::vector<double>(states, kUnreached));
-  const auto total_at = [&](long i) -> std::vector<double>& { return totals[static_cast<std::size_t>(i % (K + 1))]; };
-  // How each state was reached: the state before the move and the move's steps (1 or K).
-  std::vector<std::vector<int>> from(static_cast<std::size_t>(steps), std::vector<int>(states, -1));
-  std::vector<std::vector<std::uint8_t>> move(static_cast<std::size_t>(steps), std::vector<std::uint8_t>(states, 1));
-  // Values of the lattice views looking at the centroid, and of every state as the camera there can be turned.
-  std::vector<std::vector<double>> looking(static_cast<std::size_t>(steps), std::vector<double>(static_cast<std::size_t>(n), 0.0));
+  const auto nv = static_cast<std::size_t>(n);
+  // Every state's value at every step as far as it is known: a lattice
+  // view's as it looks at the centroid, exact or an upper bound; a state's
+  // whose camera has not turned to the centroid yet, and the approach's, as
+  // the camera there is turned by then.
+  enum Known : char { kUnknown = 0, kLooking = 1, kAtMost = 2, kTurned = 3 };
   std::vector<std::vector<double>> value(static_cast<std::size_t>(steps), std::vector<double>(states, 0.0));
+  std::vector<std::vector<char>> known(static_cast<std::size_t>(steps), std::vector<char>(states, kUnknown));
+  const auto exact = [&](std::size_t si, std::size_t s) { return known[si][s] == kLooking || known[si][s] == kTurned; };
   auto position = [&](std::size_t s, long i) -> Eigen::Vector3d {
-    return s < static_cast<std::size_t>(n) ? Eigen::Vector3d(c[static_cast<std::size_t>(i)] + r_sphere * d.col(static_cast<Eigen::Index>(s)))
-                                           : a[s - static_cast<std::size_t>(n)];
+    return s < nv ? Eigen::Vector3d(c[static_cast<std::size_t>(i)] + r_sphere * d.col(static_cast<Eigen::Index>(s)))
+                  : a[s - nv];
   };
   // A camera off its sphere need not reach it along the radius first:
   // straight moves from the start to a lattice view at constant speed, in
@@ -357,7 +381,7 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     double sum = 0.0;
   };
   std::vector<Direct> direct;
-  std::vector<int> direct_to(static_cast<std::size_t>(n), -1);
+  std::vector<int> direct_to(nv, -1);
   for (int v = 0; v < n && chain > 0; ++v) {
     for (long k = 1; k <= std::min<long>({chain + kDirectSteps, 255, steps - 1}); ++k) {
       if ((position(static_cast<std::size_t>(v), k) - start).norm() <= static_cast<double>(k) * reach) {
@@ -388,20 +412,48 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     wMc.translation() = o;
     return wMc;
   };
-  // Each lattice view's last value looking at the centroid, whether it
-  // still holds (no moving body came near the view's cone of sight since),
-  // whether it is this step's; and the margin beyond step x reach from the
-  // start within which a lattice view may stand for the camera (a straight
-  // move's steps are valued at the view nearest its great circle, within 2
-  // spacings, or at its ends, K steps away, each within reach).
-  std::vector<double> kept(static_cast<std::size_t>(n), 0.0);
-  std::vector<char> holds(static_cast<std::size_t>(n), 0), valued(static_cast<std::size_t>(n), 0);
-  const double margin = 2.0 * settings.spacing + K * reach + 1e-9;
+  // Values cast at step i: the lattice views `views` looking at the
+  // centroid, each only as far as it could reach its `at_least`.
+  long renderer_step = -1;  // the renderer is at this step's time
+  const auto cast = [&](long i, const std::vector<int>& views, const std::vector<double>& at_least) {
+    if (views.empty()) return;
+    const auto si = static_cast<std::size_t>(i);
+    if (renderer_step != i) renderer.set_time(plan.times[si]);
+    renderer_step = i;
+    std::vector<Eigen::Isometry3d> poses;
+    poses.reserve(views.size());
+    for (const int v : views) poses.push_back(looking_at(position(static_cast<std::size_t>(v), i), c[si], wMc_start));
+    std::vector<char> whole;
+    const std::vector<double> seen = renderer.visible_fractions(poses, at_least, whole);
+    plan.evaluations += static_cast<long>(seen.size());
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+      const auto sv = static_cast<std::size_t>(views[k]);
+      value[si][sv] = seen[k];
+      known[si][sv] = whole[k] != 0 ? kLooking : kAtMost;
+    }
+  };
+
+  // First a scan of the steps: the best lattice view at each step on its own
+  // (the unlimited bound), the values of the states whose camera is not
+  // turned to the centroid yet, and `upper`, the best value of any state at
+  // each step. A view keeps its last value while no moving body comes near
+  // its cone of sight to the object (`still`, per step and view: -1 not
+  // tested yet). The kProbes views best at the step before are valued
+  // first; the others only as far as they could beat the best of them.
+  constexpr int kProbes = 32;
+  std::vector<Changes> changes_at(static_cast<std::size_t>(steps));  // since the step before
+  std::vector<std::vector<signed char>> still(static_cast<std::size_t>(steps), std::vector<signed char>(nv, -1));
+  const auto unchanged = [&](long i, std::size_t v) {
+    signed char& s = still[static_cast<std::size_t>(i)][v];
+    if (s < 0) s = may_change(changes_at[static_cast<std::size_t>(i)], position(v, i)) ? 0 : 1;
+    return s == 1;
+  };
+  std::vector<double> upper(static_cast<std::size_t>(steps), 0.0);
   std::vector<TriangleMesh> meshes(scenario.bodies.size());
   std::vector<std::vector<Ball>> pieces(scenario.bodies.size());  // of the bodies that moved, at the last step
   for (long i = 0; i < steps; ++i) {
     const auto si = static_cast<std::size_t>(i);
-    Changes changes;
+    Changes& changes = changes_at[si];
     for (std::size_t b = 0; b < scenario.bodies.size(); ++b) {
       TriangleMesh m = scenario.bodies[b].world_mesh(plan.times[si]);
       const bool object = scenario.bodies[b].role == Role::Object;
@@ -418,53 +470,53 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       }
       meshes[b] = std::move(m);
     }
-    // The lattice views looking at the centroid, first those the camera can
-    // be at by now (within step x reach of the start: no move goes farther
-    // in a step; `margin` for the views that stand for a straight move's
-    // steps), then, unless one of those sees all, every other view (the
-    // unlimited bound is the best of them all). A view keeps its last value
-    // while no moving body comes near its cone of sight.
-    for (int v = 0; v < n && i > 0; ++v) {
+    // The lattice views: what still holds from the step before, the probes,
+    // then the others as far as they could beat the best so far (none if a
+    // view sees all: a fraction is at most 1).
+    double best = kUnreached;
+    tbb::parallel_for(0, n, [&](int v) {
       const auto sv = static_cast<std::size_t>(v);
-      if (holds[sv] && may_change(changes, position(sv, i))) holds[sv] = 0;
+      if (i > 0 && known[si - 1][sv] != kUnknown && unchanged(i, sv)) {
+        const bool looking = known[si - 1][sv] == kLooking || known[si - 1][sv] == kAtMost;
+        value[si][sv] = value[si - 1][sv];
+        known[si][sv] = looking ? known[si - 1][sv] : static_cast<char>(kUnknown);
+      }
+    });
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (known[si][v] == kLooking) best = std::max(best, value[si][v]);
     }
-    renderer.set_time(plan.times[si]);
-    std::fill(valued.begin(), valued.end(), 0);
-    double best_view = kUnreached;
-    const auto value_views = [&](bool reachable_only) {
-      std::vector<int> evaluate;
-      std::vector<Eigen::Isometry3d> poses;
-      for (int v = 0; v < n; ++v) {
-        const auto sv = static_cast<std::size_t>(v);
-        const Eigen::Vector3d o = position(sv, i);
-        if (valued[sv] || (reachable_only && (o - start).norm() > static_cast<double>(i) * reach + margin)) continue;
-        valued[sv] = 1;
-        if (holds[sv]) {
-          looking[si][sv] = kept[sv];
-          best_view = std::max(best_view, kept[sv]);
-          continue;
-        }
-        evaluate.push_back(v);
-        poses.push_back(looking_at(o, c[si], wMc_start));
-      }
-      if (poses.empty()) return;
-      const std::vector<double> seen = renderer.visible_fractions(poses);
-      plan.evaluations += static_cast<long>(seen.size());
-      for (std::size_t k = 0; k < seen.size(); ++k) {
-        const auto sv = static_cast<std::size_t>(evaluate[k]);
-        looking[si][sv] = kept[sv] = seen[k];
-        holds[sv] = 1;
-        best_view = std::max(best_view, seen[k]);
-      }
+    std::vector<int> order;
+    for (int v = 0; v < n; ++v) {
+      if (known[si][static_cast<std::size_t>(v)] != kLooking) order.push_back(v);
+    }
+    const auto last_value = [&](int v) {
+      return i > 0 && known[si - 1][static_cast<std::size_t>(v)] != kUnknown ? value[si - 1][static_cast<std::size_t>(v)] : -1.0;
     };
-    value_views(true);
-    if (best_view < 1.0) value_views(false);  // a fraction is at most 1
-    plan.best_visible.push_back(best_view);
-    // The programme's values: the camera's, which cannot look at the
-    // centroid before it has turned there. Views the camera can have reached
-    // by now that it could not have turned at yet are cast as turned so far;
-    // the approach states reached, as the camera there is turned by now.
-    std::copy(looking[si].begin(), looking[si].end(), value[si].begin());
+    const auto probes = std::min<std::size_t>(kProbes, order.size());
+    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(probes), order.end(), [&](int u, int v) {
+      const double lu = last_value(u), lv = last_value(v);
+      return lu > lv || (lu == lv && u < v);
+    });
+    const std::vector<int> probe(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(probes));
+    cast(i, probe, std::vector<double>(probe.size(), kUnreached));
+    for (const int v : probe) best = std::max(best, value[si][static_cast<std::size_t>(v)]);
+    if (best < 1.0) {
+      std::vector<int> rest;
+      for (std::size_t k = probes; k < order.size(); ++k) {
+        const auto sv = static_cast<std::size_t>(order[k]);
+        if (!(known[si][sv] == kAtMost && value[si][sv] < best)) rest.push_back(order[k]);
+      }
+      cast(i, rest, std::vector<double>(rest.size(), best));
+      for (const int v : rest) {
+        if (known[si][static_cast<std::size_t>(v)] == kLooking) best = std::max(best, value[si][static_cast<std::size_t>(v)]);
+      }
+    }
+    plan.best_visible.push_back(best);
+    upper[si] = best;
+    // The camera's values where it cannot look at the centroid yet: views it
+    // can have reached by now that it could not have turned at yet are cast
+    // as turned so far; the approach states reached, as the camera there is
+    // turned by now; the straight moves from the start on their way.
     std::vector<int> evaluate;
     std::vector<Eigen::Isometry3d> poses;
     for (int v = 0; v < n && i > 0; ++v) {
@@ -477,24 +529,19 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       poses.push_back(pose);
     }
     for (int j = 0; j <= std::min<long>(chain, i); ++j) {
+      const auto s = nv + static_cast<std::size_t>(j);
       const Eigen::Vector3d& o = a[static_cast<std::size_t>(j)];
       bool turned_before = false;
       if (j < i) (void)aimed(o, i - 1, &turned_before);
       if (turned_before && !may_change(changes, o)) {
-        value[si][static_cast<std::size_t>(n + j)] = value[si - 1][static_cast<std::size_t>(n + j)];
+        value[si][s] = value[si - 1][s];
+        known[si][s] = kTurned;
         continue;
       }
       bool turned = false;
-      evaluate.push_back(n + j);
+      evaluate.push_back(static_cast<int>(s));
       poses.push_back(aimed(o, i, &turned));
     }
-    if (!poses.empty()) {
-      const std::vector<double> seen = renderer.visible_fractions(poses);
-      plan.evaluations += static_cast<long>(seen.size());
-      for (std::size_t k = 0; k < seen.size(); ++k) value[si][static_cast<std::size_t>(evaluate[k])] = seen[k];
-    }
-
-    poses.clear();
     std::vector<std::size_t> under_way;  // the straight moves from the start not at their view yet
     for (std::size_t g = 0; g < direct.size() && i > 0; ++g) {
       if (direct[g].k <= i) continue;
@@ -503,96 +550,212 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       poses.push_back(aimed(on_the_way(direct[g], i), i, &turned));
     }
     if (!poses.empty()) {
+      if (renderer_step != i) renderer.set_time(plan.times[si]);
+      renderer_step = i;
       const std::vector<double> seen = renderer.visible_fractions(poses);
       plan.evaluations += static_cast<long>(seen.size());
-      for (std::size_t k = 0; k < seen.size(); ++k) direct[under_way[k]].sum += seen[k];
+      for (std::size_t k = 0; k < seen.size(); ++k) {
+        upper[si] = std::max(upper[si], seen[k]);
+        if (k < evaluate.size()) {
+          value[si][static_cast<std::size_t>(evaluate[k])] = seen[k];
+          known[si][static_cast<std::size_t>(evaluate[k])] = kTurned;
+        } else {
+          direct[under_way[k - evaluate.size()]].sum += seen[k];
+        }
+      }
     }
+    for (std::size_t s = nv; s < states; ++s) {
+      if (known[si][s] == kTurned) upper[si] = std::max(upper[si], value[si][s]);
+    }
+  }
+  // Of the steps after each, the sum of their best values.
+  std::vector<double> after(static_cast<std::size_t>(steps), 0.0);
+  for (long i = steps - 2; i >= 0; --i) {
+    after[static_cast<std::size_t>(i)] = after[static_cast<std::size_t>(i + 1)] + upper[static_cast<std::size_t>(i + 1)];
+  }
 
-    if (i == 0) {
-      total_at(0)[static_cast<std::size_t>(n)] = value[si][static_cast<std::size_t>(n)];
-      continue;
+  // A lattice view's looking value at step i from an earlier step where it
+  // is known exactly, if no moving body came near its cone of sight since.
+  const auto carried = [&](long i, std::size_t v) {
+    for (long j = i; j > 0 && unchanged(j, v); --j) {
+      if (known[static_cast<std::size_t>(j - 1)][v] == kLooking) {
+        value[static_cast<std::size_t>(i)][v] = value[static_cast<std::size_t>(j - 1)][v];
+        known[static_cast<std::size_t>(i)][v] = kLooking;
+        return true;
+      }
     }
-    const std::vector<double>& total = total_at(i - 1);
-    std::vector<double>& next = total_at(i);
-    std::fill(next.begin(), next.end(), kUnreached);
-    // Lattice views: from a neighbour within reach, from the end of the
-    // approach, or by a straight move of K steps (its centroid's largest move
-    // in a step plus the camera's on the sphere within reach).
-    const std::size_t end = static_cast<std::size_t>(n + chain);
-    double shift = 0.0;
-    for (long j = std::max(1L, i - K + 1); j <= i && K > 1; ++j) {
-      shift = std::max(shift, (c[static_cast<std::size_t>(j)] - c[static_cast<std::size_t>(j - 1)]).norm());
+    return false;
+  };
+  // The straight moves from each view (segments by where they start).
+  std::vector<std::vector<std::size_t>> moves_from(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    for (std::size_t g = segments.first[v]; g < segments.first[v + 1]; ++g) {
+      moves_from[static_cast<std::size_t>(segments.from[g])].push_back(g);
     }
-    const std::vector<double>* before_move = i >= K && K > 1 ? &total_at(i - K) : nullptr;
-    tbb::parallel_for(0, n, [&](int v) {
-      const auto sv = static_cast<std::size_t>(v);
-      const Eigen::Vector3d here = position(sv, i);
-      double best = kUnreached;
-      int arg = -1;
-      std::uint8_t steps_of_move = 1;
-      for (const int u : near[sv]) {
-        const double t = total[static_cast<std::size_t>(u)];
-        if (t > best && (here - position(static_cast<std::size_t>(u), i - 1)).norm() <= reach) {
-          best = t;
-          arg = u;
+  }
+
+  // Then the programme, twice. First keeping at each step only the kBeam
+  // lattice states of the largest totals: a path, whose total is `floor`.
+  // Then keeping every state whose total, with the best values of the steps
+  // after it, can still reach the floor: the best path is among them (the
+  // others cannot beat the first path), so the second programme is exact;
+  // it values only the states it may keep, each only as far as it could
+  // still reach the floor, and the views that stand for the straight moves'
+  // steps from the states it keeps. The best totals of the last K + 1 steps
+  // (K = segment steps), in turn.
+  constexpr std::size_t kBeam = 64;
+  const double slack = 1e-9 * static_cast<double>(steps);  // rounding of sums in another order
+  std::vector<std::vector<double>> totals(static_cast<std::size_t>(K + 1), std::vector<double>(states, kUnreached));
+  const auto total_at = [&](long i) -> std::vector<double>& { return totals[static_cast<std::size_t>(i % (K + 1))]; };
+  // How each state was reached: the state before the move and the move's steps (1 or K).
+  std::vector<std::vector<int>> from(static_cast<std::size_t>(steps), std::vector<int>(states, -1));
+  std::vector<std::vector<std::uint8_t>> move(static_cast<std::size_t>(steps), std::vector<std::uint8_t>(states, 1));
+  std::vector<double> came(nv);  // the best total before the move into each lattice view
+  std::vector<int> came_from(nv);
+  std::vector<std::uint8_t> came_by(nv);
+  std::vector<char> stands_for(nv);  // views that stand for a straight move's step here
+  std::size_t last = states - 1;     // the best final state
+  const auto programme = [&](bool beam, double floor) {
+    for (std::vector<double>& t : totals) std::fill(t.begin(), t.end(), kUnreached);
+    total_at(0)[nv] = value[0][nv];
+    for (long i = 1; i < steps; ++i) {
+      const auto si = static_cast<std::size_t>(i);
+      const std::vector<double>& total = total_at(i - 1);
+      std::vector<double>& next = total_at(i);
+      std::fill(next.begin(), next.end(), kUnreached);
+      // Lattice views: from a neighbour within reach, from the end of the
+      // approach, or by a straight move of K steps (its centroid's largest move
+      // in a step plus the camera's on the sphere within reach).
+      const std::size_t end = nv + static_cast<std::size_t>(chain);
+      double shift = 0.0;
+      for (long j = std::max(1L, i - K + 1); j <= i && K > 1; ++j) {
+        shift = std::max(shift, (c[static_cast<std::size_t>(j)] - c[static_cast<std::size_t>(j - 1)]).norm());
+      }
+      const std::vector<double>* before_move = i >= K && K > 1 ? &total_at(i - K) : nullptr;
+      tbb::parallel_for(0, n, [&](int v) {
+        const auto sv = static_cast<std::size_t>(v);
+        const Eigen::Vector3d here = position(sv, i);
+        double best = kUnreached;
+        int arg = -1;
+        std::uint8_t steps_of_move = 1;
+        for (const int u : near[sv]) {
+          const double t = total[static_cast<std::size_t>(u)];
+          if (t > best && (here - position(static_cast<std::size_t>(u), i - 1)).norm() <= reach) {
+            best = t;
+            arg = u;
+          }
         }
-      }
-      if (total[end] > best && (here - a[static_cast<std::size_t>(chain)]).norm() <= reach) {
-        best = total[end];
-        arg = static_cast<int>(end);
-      }
-      if (const int g = direct_to[sv]; g >= 0 && direct[static_cast<std::size_t>(g)].k == i) {
-        const double t = value[0][static_cast<std::size_t>(n)] + direct[static_cast<std::size_t>(g)].sum;
-        if (t > best) {
-          best = t;
-          arg = n;
-          steps_of_move = static_cast<std::uint8_t>(i);
+        if (total[end] > best && (here - a[static_cast<std::size_t>(chain)]).norm() <= reach) {
+          best = total[end];
+          arg = static_cast<int>(end);
         }
-      }
-      if (before_move != nullptr) {
-        for (std::size_t g = segments.first[sv]; g < segments.first[sv + 1]; ++g) {
-          double t = (*before_move)[static_cast<std::size_t>(segments.from[g])];
-          if (!(t > kUnreached) || shift + r_sphere * segments.step_chord[g] > reach) continue;
-          const int* mid = &segments.mids[g * static_cast<std::size_t>(K - 1)];
-          for (int m = 1; m < K; ++m) t += value[si - static_cast<std::size_t>(K - m)][static_cast<std::size_t>(mid[m - 1])];
+        if (const int g = direct_to[sv]; g >= 0 && direct[static_cast<std::size_t>(g)].k == i) {
+          const double t = value[0][nv] + direct[static_cast<std::size_t>(g)].sum;
           if (t > best) {
             best = t;
-            arg = segments.from[g];
-            steps_of_move = static_cast<std::uint8_t>(K);
+            arg = n;
+            steps_of_move = static_cast<std::uint8_t>(i);
+          }
+        }
+        if (before_move != nullptr) {
+          for (std::size_t g = segments.first[sv]; g < segments.first[sv + 1]; ++g) {
+            double t = (*before_move)[static_cast<std::size_t>(segments.from[g])];
+            if (!(t > kUnreached) || shift + r_sphere * segments.step_chord[g] > reach) continue;
+            const int* mid = &segments.mids[g * static_cast<std::size_t>(K - 1)];
+            for (int m = 1; m < K; ++m) {
+              const auto sj = si - static_cast<std::size_t>(K - m);
+              const auto sm = static_cast<std::size_t>(mid[m - 1]);
+              if (!exact(sj, sm)) throw std::logic_error("hindsight planner: a straight move's step was not valued");
+              t += value[sj][sm];
+            }
+            if (t > best) {
+              best = t;
+              arg = segments.from[g];
+              steps_of_move = static_cast<std::uint8_t>(K);
+            }
+          }
+        }
+        came[sv] = best;
+        came_from[sv] = arg;
+        came_by[sv] = steps_of_move;
+      });
+      // The views that stand for the m-th step of a straight move from a
+      // state kept at step i - m.
+      std::fill(stands_for.begin(), stands_for.end(), 0);
+      for (int m = 1; m < K && m <= i; ++m) {
+        const std::vector<double>& kept = total_at(i - m);
+        for (std::size_t u = 0; u < nv; ++u) {
+          if (!(kept[u] > kUnreached)) continue;
+          for (const std::size_t g : moves_from[u]) {
+            stands_for[static_cast<std::size_t>(segments.mids[g * static_cast<std::size_t>(K - 1) + static_cast<std::size_t>(m - 1)])] = 1;
           }
         }
       }
-      if (arg >= 0) {
-        next[sv] = best + value[si][sv];
-        from[si][sv] = arg;
-        move[si][sv] = steps_of_move;
+      // What must be valued here, as far as it matters.
+      std::vector<int> views;
+      std::vector<double> at_least;
+      for (std::size_t v = 0; v < nv; ++v) {
+        if ((came_from[v] < 0 && !stands_for[v]) || exact(si, v) || carried(i, v)) continue;
+        double need = kUnreached;
+        if (!beam && !stands_for[v]) {
+          need = floor - slack - after[si] - came[v];
+          if (known[si][v] == kAtMost && value[si][v] < need) continue;  // cannot reach the floor
+        }
+        views.push_back(static_cast<int>(v));
+        at_least.push_back(need);
       }
-    });
-    // The approach: stay, or go one state on.
-    for (int j = 0; j <= chain; ++j) {
-      const auto s = static_cast<std::size_t>(n + j);
-      double best = total[s];
-      int arg = static_cast<int>(s);
-      if (j > 0 && total[s - 1] > best) {
-        best = total[s - 1];
-        arg = static_cast<int>(s - 1);
+      cast(i, views, at_least);
+      for (std::size_t v = 0; v < nv; ++v) {
+        if (came_from[v] < 0 || !exact(si, v)) continue;
+        next[v] = came[v] + value[si][v];
+        from[si][v] = came_from[v];
+        move[si][v] = came_by[v];
       }
-      if (best > kUnreached) {
-        next[s] = best + value[si][s];
-        from[si][s] = arg;
+      // The approach: stay, or go one state on.
+      for (int j = 0; j <= chain; ++j) {
+        const auto s = nv + static_cast<std::size_t>(j);
+        double best = total[s];
+        int arg = static_cast<int>(s);
+        if (j > 0 && total[s - 1] > best) {
+          best = total[s - 1];
+          arg = static_cast<int>(s - 1);
+        }
+        if (best > kUnreached) {
+          next[s] = best + value[si][s];
+          from[si][s] = arg;
+        }
+      }
+      // Keep the beam, or the states that can still reach the floor.
+      if (beam) {
+        std::vector<std::pair<double, std::size_t>> ranked;
+        for (std::size_t v = 0; v < nv; ++v) {
+          if (next[v] > kUnreached) ranked.emplace_back(-next[v], v);
+        }
+        if (ranked.size() > kBeam) {
+          std::nth_element(ranked.begin(), ranked.begin() + kBeam, ranked.end());
+          for (auto r = ranked.begin() + kBeam; r != ranked.end(); ++r) next[r->second] = kUnreached;
+        }
+      } else {
+        for (std::size_t v = 0; v < nv; ++v) {
+          if (next[v] + after[si] < floor - slack) next[v] = kUnreached;
+        }
       }
     }
-  }
+    // The best final state (the approach's end first: of equal paths, the
+    // one that moves least).
+    const std::vector<double>& final_total = total_at(steps - 1);
+    last = states - 1;
+    for (std::size_t s = 0; s < nv; ++s) {
+      if (final_total[s] > final_total[last]) last = s;
+    }
+    return final_total[last];
+  };
+  const double first = programme(true, kUnreached);
+  programme(false, first);
 
-  // The best final state (the approach's end first: of equal paths, the one
-  // that moves least), then back to the start. A straight move's steps lie
+  // Back to the start from the best final state. A straight move's steps lie
   // on its great circle; the nearest views stood for them in the programme,
   // the path's own values are then cast from where the camera is.
-  const std::vector<double>& final_total = total_at(steps - 1);
-  std::size_t last = static_cast<std::size_t>(n + chain);
-  for (std::size_t s = 0; s < static_cast<std::size_t>(n); ++s) {
-    if (final_total[s] > final_total[last]) last = s;
-  }
   plan.views.resize(static_cast<std::size_t>(steps));
   plan.visible.resize(static_cast<std::size_t>(steps));
   std::vector<std::size_t> inside;  // steps inside straight moves

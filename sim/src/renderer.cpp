@@ -426,9 +426,15 @@ struct Renderer::Impl {
   // image, within its depth range and with nothing in between. No ray is
   // cast where the answer is known: a body that is its own box across every
   // line of sight (none seen), or a convex object with no other body in the
-  // way (every facing sample in view seen).
+  // way (every facing sample in view seen). Where only a fraction of at
+  // least `at_least` matters, the rays go in packets spread over the surface
+  // and stop once fewer than that can be seen: the fraction that could still
+  // be seen is returned, below `at_least`, with *exact false.
   [[nodiscard]] double visible_fraction(const Samples& target, const Eigen::Isometry3d& wMc,
-                                        const SensorSettings& sensor) const {
+                                        const SensorSettings& sensor,
+                                        double at_least = -std::numeric_limits<double>::infinity(),
+                                        bool* exact = nullptr) const {
+    if (exact != nullptr) *exact = true;
     const Eigen::Vector3d o = wMc.translation();
     const Eigen::Isometry3d cMw = wMc.inverse();
     const CameraIntrinsics& k = sensor.intrinsics;
@@ -449,11 +455,21 @@ struct Renderer::Impl {
                                    [&](const WorldPoint& w) { return w.n.dot(o - w.p) > 0.0; });
       return any ? 1.0 : 0.0;
     }
-    int facing = 0, seen = 0;
-    // Rays from the camera to the samples it may see, 16 to a packet.
-    constexpr int kPacket = 16;
+    // Rays from the camera to the facing samples in view, 16 to a packet,
+    // neighbours on the surface together. Where a threshold matters the
+    // samples go in blocks taken in bit-reversed order, spread over the
+    // surface so that an occlusion anywhere shows early, and the rays stop
+    // once the fraction that could still be seen, with every sample not yet
+    // looked at taken as facing and seen, is below the threshold.
+    constexpr int kPacket = 16, kBlock = 64;
+    const int total = static_cast<int>(target.points.size());
+    const int blocks = (total + kBlock - 1) / kBlock;
+    const bool bounded = at_least > 0.0 && cast;
+    int bits = 0;
+    while (bounded && (1 << bits) < blocks) ++bits;
+    int facing = 0, missed = 0, looked_at = 0;  // missed: facing, not seen
     alignas(64) int valid[kPacket];
-    RTCRay16 ray{};  // lanes past the last sample stay zero (and invalid)
+    RTCRay16 ray{};
     for (int j = 0; j < kPacket; ++j) {
       ray.org_x[j] = static_cast<float>(o.x());
       ray.org_y[j] = static_cast<float>(o.y());
@@ -469,38 +485,57 @@ struct Renderer::Impl {
       rtcInitIntersectContext(&context);
       context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
       rtcOccluded16(valid, scene, &context, &ray);
-      for (int j = 0; j < filled; ++j) seen += ray.tfar[j] < 0.0f ? 0 : 1;
+      for (int j = 0; j < filled; ++j) missed += ray.tfar[j] < 0.0f ? 1 : 0;
       filled = 0;
     };
-    for (const WorldPoint& w : target.points) {
-      const double towards = w.n.dot(o - w.p);
-      if (towards <= 0.0) continue;
-      ++facing;
-      if (!all_in_view) {
-        const Eigen::Vector3d pc = cMw * w.p;
-        if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth) continue;
-        const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
-        if (u < 0.0 || v < 0.0 || u > k.width - 1.0 || v > k.height - 1.0) continue;
+    for (int p = 0; p < (bounded ? 1 << bits : blocks); ++p) {
+      int q = p;
+      if (bounded) {
+        q = 0;
+        for (int bit = 0; bit < bits; ++bit) q |= ((p >> bit) & 1) << (bits - 1 - bit);
+        if (q >= blocks) continue;
       }
-      if (!cast) {
-        ++seen;
-        continue;
+      const int first = q * kBlock, end = std::min(total, first + kBlock);
+      for (int s = first; s < end; ++s) {
+        const WorldPoint& w = target.points[static_cast<std::size_t>(s)];
+        const double towards = w.n.dot(o - w.p);
+        if (towards <= 0.0) continue;
+        ++facing;
+        if (!all_in_view) {
+          const Eigen::Vector3d pc = cMw * w.p;
+          const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
+          if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth || u < 0.0 || v < 0.0 || u > k.width - 1.0 ||
+              v > k.height - 1.0) {
+            ++missed;
+            continue;
+          }
+        }
+        if (!cast) continue;
+        const Eigen::Vector3d d = w.p - o;
+        valid[filled] = -1;
+        ray.dir_x[filled] = static_cast<float>(d.x());
+        ray.dir_y[filled] = static_cast<float>(d.y());
+        ray.dir_z[filled] = static_cast<float>(d.z());
+        ray.tnear[filled] = 0.0f;
+        // Stop short of the point itself, where the ray is still kSurfaceClearance
+        // off its surface's plane: a ray that grazes the surface (the camera
+        // within a hair of its plane) would otherwise meet the surface it ends on.
+        const double short_of = std::max(1e-4, kSurfaceClearance / towards);
+        ray.tfar[filled] = static_cast<float>(std::max(0.0, 1.0 - short_of));
+        if (++filled == kPacket) trace();
       }
-      const Eigen::Vector3d d = w.p - o;
-      valid[filled] = -1;
-      ray.dir_x[filled] = static_cast<float>(d.x());
-      ray.dir_y[filled] = static_cast<float>(d.y());
-      ray.dir_z[filled] = static_cast<float>(d.z());
-      ray.tnear[filled] = 0.0f;
-      // Stop short of the point itself, where the ray is still kSurfaceClearance
-      // off its surface's plane: a ray that grazes the surface (the camera
-      // within a hair of its plane) would otherwise meet the surface it ends on.
-      const double short_of = std::max(1e-4, kSurfaceClearance / towards);
-      ray.tfar[filled] = static_cast<float>(std::max(0.0, 1.0 - short_of));
-      if (++filled == kPacket) trace();
+      if (!bounded) continue;
+      if (filled > 0) trace();
+      looked_at += end - first;
+      const int could_face = facing + total - looked_at;
+      const double could_see = could_face > 0 ? static_cast<double>(could_face - missed) / could_face : 0.0;
+      if (could_see < at_least) {
+        if (exact != nullptr) *exact = false;
+        return could_see;
+      }
     }
     if (filled > 0) trace();
-    return facing > 0 ? static_cast<double>(seen) / facing : 0.0;
+    return facing > 0 ? static_cast<double>(facing - missed) / facing : 0.0;
   }
 };
 
@@ -709,14 +744,27 @@ std::vector<Eigen::Vector3d> Renderer::object_surface() const {
 }
 
 std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometry3d>& poses) const {
+  std::vector<char> exact;
+  return visible_fractions(poses, std::vector<double>(poses.size(), -std::numeric_limits<double>::infinity()), exact);
+}
+
+std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometry3d>& poses,
+                                                const std::vector<double>& at_least, std::vector<char>& exact) const {
+  if (at_least.size() != poses.size()) {
+    throw std::invalid_argument("renderer: " + std::to_string(at_least.size()) + " thresholds for " +
+                                std::to_string(poses.size()) + " poses");
+  }
   for (const Eigen::Isometry3d& wMc : poses) {
     if (!wMc.matrix().allFinite()) throw std::invalid_argument("renderer: a camera pose is not finite");
   }
   const Impl::Samples samples = impl_->object_samples();
   std::vector<double> fractions(poses.size());
+  exact.assign(poses.size(), 1);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses.size()), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      fractions[i] = impl_->visible_fraction(samples, poses[i], scenario_.sensor);
+      bool whole = true;
+      fractions[i] = impl_->visible_fraction(samples, poses[i], scenario_.sensor, at_least[i], &whole);
+      exact[i] = whole ? 1 : 0;
     }
   });
   return fractions;

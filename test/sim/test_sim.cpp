@@ -377,6 +377,49 @@ TEST(Truth, VisibleFractionIsTheSameWhereNoShortcutApplies) {
   EXPECT_GT(part, 10);   // behind the hand, across the table's edge
 }
 
+TEST(Truth, AThresholdStopsTheRaysOnlyBelowIt) {
+  // The hindsight planner asks only whether a view can beat a threshold:
+  // below it, an upper bound (fewer rays); at or above it, the same value as
+  // without. Views all round the case with a hand in front, every ray cast
+  // (a ball inside the case is in every view's cone).
+  const Scenario s = scenario_from_yaml(
+      "sensor: {noise: {enabled: false}}\n"
+      "object: {shape: box, size: [0.19, 0.135, 0.015], position: [0, 0, 0.5]}\n"
+      "table: {position: [0, 0.09, 0.6], size: [1.2, 0.02, 1.0]}\n"
+      "occluders: [{shape: capsule, radius: 0.03, length: 0.1, rpy_deg: [0, 90, 0], position: [0.05, -0.02, 0.3]},\n"
+      "            {shape: sphere, radius: 0.004, position: [0, 0, 0.5]}]\n",
+      kSource);
+  const Renderer r(s);
+  const std::vector<Eigen::Isometry3d> views = views_around({0, 0, 0.5}, 0.5, 400);
+  const std::vector<double> value = r.visible_fractions(views);
+  int stopped = 0, parts = 0;
+  for (const double threshold : {0.3, 0.9, 0.999}) {
+    std::vector<char> exact;
+    const std::vector<double> bounded = r.visible_fractions(views, std::vector<double>(views.size(), threshold), exact);
+    ASSERT_EQ(bounded.size(), views.size());
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      if (exact[i] != 0) {
+        EXPECT_EQ(bounded[i], value[i]) << "view " << i << ", threshold " << threshold;
+      } else {
+        EXPECT_LT(bounded[i], threshold) << "view " << i;
+        EXPECT_GE(bounded[i], value[i]) << "view " << i;
+        EXPECT_LT(value[i], threshold) << "view " << i;
+        ++stopped;
+      }
+      if (value[i] >= threshold) {
+        EXPECT_NE(exact[i], 0) << "view " << i << ", threshold " << threshold;
+      }
+      parts += value[i] > 0.0 && value[i] < 1.0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(parts, 10);    // views that see part of the case
+  EXPECT_GT(stopped, 10);  // views whose rays stopped early
+  std::vector<char> exact;
+  EXPECT_THROW((void)r.visible_fractions(views, {0.5}, exact), std::invalid_argument);
+  const std::vector<double> none = r.visible_fractions(views, std::vector<double>(views.size(), 0.0), exact);
+  EXPECT_EQ(none, value);  // a threshold of 0 never stops the rays
+}
+
 TEST(Truth, AFaceSeenEdgeOnIsNotHiddenByItself) {
   // A camera within a hair of the plane of the case's right face sees that
   // face edge-on: the rays to its samples run along it. Nothing hides them

@@ -33,14 +33,21 @@
  *
  * The cost is at most views x steps visibility evaluations (each ray casts
  * the object's surface samples that face the view) plus views x (neighbours
- * + straight moves x segment_steps) x steps for the programme. A view keeps
- * its value while no moving body comes near its cone of sight to the object,
- * so a still scene values each view once; and a step values only the views
- * the camera can be at by then (within step x max_speed x the step of the
- * start, and a margin for the views that stand for a straight move's steps)
- * unless none of them sees the whole object, when the unlimited bound needs
- * every view's value. HindsightPlan records the views, the evaluations made
- * and the planning time.
+ * + straight moves x segment_steps) x steps for the programme; far fewer
+ * are made. A view keeps its value while no moving body comes near its cone
+ * of sight to the object, so a still scene values each view once. A first
+ * scan of the steps finds the best view at each (the unlimited bound): the
+ * views best at the step before first, then the others only as far as they
+ * could beat those (their rays stop once they cannot; none when a view sees
+ * all). Then the programme runs twice: keeping only the 64 best totals at
+ * each step, which gives a path and its total; then keeping every state
+ * whose total, with the best view's value at every step after it, can still
+ * reach that total. No path through the others can beat the first one, so
+ * the second programme is exact (the same plan as a programme over every
+ * state); it values only the states it keeps, each only as far as it could
+ * still reach the first total, and the views that stand for the straight
+ * moves' steps from them. HindsightPlan records the views, the evaluations
+ * made and the planning time.
  */
 #pragma once
 
@@ -77,7 +84,7 @@ struct HindsightPlan {
   double bound = 0.0;            ///< mean of `visible`: the limit under the speed limit
   double unlimited_bound = 0.0;  ///< mean of `best_visible`: the limit without a speed limit
   int lattice_views = 0;         ///< views on the sphere
-  long evaluations = 0;          ///< visibility evaluations (views x steps and the approach)
+  long evaluations = 0;          ///< visibility evaluations, those stopped early included
   double seconds = 0.0;          ///< planning time (wall clock) [s]
 
   /// \brief The planned position at time t [s]: between two steps on the
