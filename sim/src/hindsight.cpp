@@ -413,7 +413,9 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     return wMc;
   };
   // Values cast at step i: the lattice views `views` looking at the
-  // centroid, each only as far as it could reach its `at_least`.
+  // centroid, each only as far as it could reach its `at_least`, its rays
+  // first to the samples it last found not seen (`not_seen`, a bitset a view).
+  std::vector<std::vector<std::uint64_t>> not_seen(nv);
   long renderer_step = -1;  // the renderer is at this step's time
   const auto cast = [&](long i, const std::vector<int>& views, const std::vector<double>& at_least) {
     if (views.empty()) return;
@@ -423,13 +425,16 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     std::vector<Eigen::Isometry3d> poses;
     poses.reserve(views.size());
     for (const int v : views) poses.push_back(looking_at(position(static_cast<std::size_t>(v), i), c[si], wMc_start));
+    std::vector<std::vector<std::uint64_t>> missed(views.size());
+    for (std::size_t k = 0; k < views.size(); ++k) missed[k].swap(not_seen[static_cast<std::size_t>(views[k])]);
     std::vector<char> whole;
-    const std::vector<double> seen = renderer.visible_fractions(poses, at_least, whole);
+    const std::vector<double> seen = renderer.visible_fractions(poses, at_least, whole, &missed);
     plan.evaluations += static_cast<long>(seen.size());
     for (std::size_t k = 0; k < seen.size(); ++k) {
       const auto sv = static_cast<std::size_t>(views[k]);
       value[si][sv] = seen[k];
       known[si][sv] = whole[k] != 0 ? kLooking : kAtMost;
+      not_seen[sv].swap(missed[k]);
     }
   };
 
@@ -438,9 +443,19 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   // turned to the centroid yet, and `upper`, the best value of any state at
   // each step. A view keeps its last value while no moving body comes near
   // its cone of sight to the object (`still`, per step and view: -1 not
-  // tested yet). The kProbes views best at the step before are valued
-  // first; the others only as far as they could beat the best of them.
-  constexpr int kProbes = 32;
+  // tested yet). The views go in batches: first the kProbes best at the
+  // step before, valued exactly; then the others (those best at the step
+  // before first, then spread over the sphere), each batch only as far as
+  // it could beat the best of the batches before, until one sees all.
+  constexpr std::size_t kProbes = 32, kBatch = 1024;
+  std::vector<int> spread(nv);  // a view's rank in an order spread over the sphere: bit-reversed indices
+  int bits = 0;
+  while ((std::size_t{1} << bits) < nv) ++bits;
+  for (std::size_t v = 0; v < nv; ++v) {
+    std::size_t r = 0;
+    for (int bit = 0; bit < bits; ++bit) r |= ((v >> bit) & 1u) << (bits - 1 - bit);
+    spread[v] = static_cast<int>(r);
+  }
   std::vector<Changes> changes_at(static_cast<std::size_t>(steps));  // since the step before
   std::vector<std::vector<signed char>> still(static_cast<std::size_t>(steps), std::vector<signed char>(nv, -1));
   const auto unchanged = [&](long i, std::size_t v) {
@@ -470,9 +485,8 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       }
       meshes[b] = std::move(m);
     }
-    // The lattice views: what still holds from the step before, the probes,
-    // then the others as far as they could beat the best so far (none if a
-    // view sees all: a fraction is at most 1).
+    // The lattice views: what still holds from the step before, then the
+    // batches (none once a view sees all: a fraction is at most 1).
     double best = kUnreached;
     tbb::parallel_for(0, n, [&](int v) {
       const auto sv = static_cast<std::size_t>(v);
@@ -492,22 +506,20 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     const auto last_value = [&](int v) {
       return i > 0 && known[si - 1][static_cast<std::size_t>(v)] != kUnknown ? value[si - 1][static_cast<std::size_t>(v)] : -1.0;
     };
-    const auto probes = std::min<std::size_t>(kProbes, order.size());
-    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(probes), order.end(), [&](int u, int v) {
+    std::sort(order.begin(), order.end(), [&](int u, int v) {
       const double lu = last_value(u), lv = last_value(v);
-      return lu > lv || (lu == lv && u < v);
+      return lu > lv || (lu == lv && spread[static_cast<std::size_t>(u)] < spread[static_cast<std::size_t>(v)]);
     });
-    const std::vector<int> probe(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(probes));
-    cast(i, probe, std::vector<double>(probe.size(), kUnreached));
-    for (const int v : probe) best = std::max(best, value[si][static_cast<std::size_t>(v)]);
-    if (best < 1.0) {
-      std::vector<int> rest;
-      for (std::size_t k = probes; k < order.size(); ++k) {
+    for (std::size_t k = 0; k < order.size() && best < 1.0;) {
+      const bool probes = k == 0;
+      const std::size_t end = std::min(order.size(), k + (probes ? kProbes : kBatch));
+      std::vector<int> batch;
+      for (; k < end; ++k) {
         const auto sv = static_cast<std::size_t>(order[k]);
-        if (!(known[si][sv] == kAtMost && value[si][sv] < best)) rest.push_back(order[k]);
+        if (!(known[si][sv] == kAtMost && value[si][sv] < best)) batch.push_back(order[k]);
       }
-      cast(i, rest, std::vector<double>(rest.size(), best));
-      for (const int v : rest) {
+      cast(i, batch, std::vector<double>(batch.size(), probes ? kUnreached : best));
+      for (const int v : batch) {
         if (known[si][static_cast<std::size_t>(v)] == kLooking) best = std::max(best, value[si][static_cast<std::size_t>(v)]);
       }
     }

@@ -427,17 +427,22 @@ struct Renderer::Impl {
   // cast where the answer is known: a body that is its own box across every
   // line of sight (none seen), or a convex object with no other body in the
   // way (every facing sample in view seen). Where only a fraction of at
-  // least `at_least` matters, the rays go in packets spread over the surface
-  // and stop once fewer than that can be seen: the fraction that could still
-  // be seen is returned, below `at_least`, with *exact false.
+  // least `at_least` matters, the samples in *missed (a bitset: those an
+  // earlier call found not seen) go first, then the others in blocks spread
+  // over the surface, and the rays stop once fewer than that can be seen:
+  // the fraction that could still be seen is returned, below `at_least`,
+  // with *exact false; then *missed becomes the samples this call found not
+  // seen (it is left as it was where no threshold matters).
   [[nodiscard]] double visible_fraction(const Samples& target, const Eigen::Isometry3d& wMc,
                                         const SensorSettings& sensor,
                                         double at_least = -std::numeric_limits<double>::infinity(),
-                                        bool* exact = nullptr) const {
+                                        bool* exact = nullptr, std::vector<std::uint64_t>* missed = nullptr) const {
     if (exact != nullptr) *exact = true;
     const Eigen::Vector3d o = wMc.translation();
     const Eigen::Isometry3d cMw = wMc.inverse();
     const CameraIntrinsics& k = sensor.intrinsics;
+    const int total = static_cast<int>(target.points.size());
+    const auto words = static_cast<std::size_t>((total + 63) / 64);
     // When the samples' ball lies in the image and the depth range (by far
     // more than rounding), so does every sample: no need to project each.
     const Eigen::Vector3d b = cMw * target.centre;
@@ -456,19 +461,34 @@ struct Renderer::Impl {
       return any ? 1.0 : 0.0;
     }
     // Rays from the camera to the facing samples in view, 16 to a packet,
-    // neighbours on the surface together. Where a threshold matters the
-    // samples go in blocks taken in bit-reversed order, spread over the
-    // surface so that an occlusion anywhere shows early, and the rays stop
-    // once the fraction that could still be seen, with every sample not yet
-    // looked at taken as facing and seen, is below the threshold.
+    // neighbours on the surface together. Where a threshold matters, the
+    // samples missed before go first and the others follow in blocks taken
+    // in bit-reversed order, spread over the surface so that an occlusion
+    // anywhere shows early; the rays stop once the fraction that could still
+    // be seen, every sample not yet looked at taken as facing and seen, is
+    // below the threshold.
     constexpr int kPacket = 16, kBlock = 64;
-    const int total = static_cast<int>(target.points.size());
     const int blocks = (total + kBlock - 1) / kBlock;
     const bool bounded = at_least > 0.0 && cast;
+    // Which samples were missed before and which have been looked at: only
+    // where a threshold matters.
+    const bool track = bounded && missed != nullptr;
+    thread_local std::vector<std::uint64_t> earlier, done;
+    if (track) {
+      earlier.assign(words, 0);
+      for (std::size_t w = 0; w < std::min(words, missed->size()); ++w) earlier[w] = (*missed)[w];
+      missed->assign(words, 0);
+      done.assign(words, 0);
+    }
     int bits = 0;
     while (bounded && (1 << bits) < blocks) ++bits;
-    int facing = 0, missed = 0, looked_at = 0;  // missed: facing, not seen
+    int facing = 0, not_seen = 0, looked_at = 0;
+    const auto found = [&](int sample) {
+      ++not_seen;
+      if (track) (*missed)[static_cast<std::size_t>(sample) / 64] |= std::uint64_t{1} << (sample % 64);
+    };
     alignas(64) int valid[kPacket];
+    int lane_sample[kPacket];
     RTCRay16 ray{};
     for (int j = 0; j < kPacket; ++j) {
       ray.org_x[j] = static_cast<float>(o.x());
@@ -480,14 +500,72 @@ struct Renderer::Impl {
     }
     int filled = 0;
     auto trace = [&] {
+      if (filled == 0) return;
       for (int j = filled; j < kPacket; ++j) valid[j] = 0;
       RTCIntersectContext context;
       rtcInitIntersectContext(&context);
       context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
       rtcOccluded16(valid, scene, &context, &ray);
-      for (int j = 0; j < filled; ++j) missed += ray.tfar[j] < 0.0f ? 1 : 0;
+      for (int j = 0; j < filled; ++j) {
+        if (ray.tfar[j] < 0.0f) found(lane_sample[j]);
+      }
       filled = 0;
     };
+    const auto look_at = [&](int sample) {
+      if (track) done[static_cast<std::size_t>(sample) / 64] |= std::uint64_t{1} << (sample % 64);
+      ++looked_at;
+      const WorldPoint& w = target.points[static_cast<std::size_t>(sample)];
+      const double towards = w.n.dot(o - w.p);
+      if (towards <= 0.0) return;
+      ++facing;
+      if (!all_in_view) {
+        const Eigen::Vector3d pc = cMw * w.p;
+        const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
+        if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth || u < 0.0 || v < 0.0 || u > k.width - 1.0 ||
+            v > k.height - 1.0) {
+          found(sample);
+          return;
+        }
+      }
+      if (!cast) return;
+      const Eigen::Vector3d d = w.p - o;
+      valid[filled] = -1;
+      lane_sample[filled] = sample;
+      ray.dir_x[filled] = static_cast<float>(d.x());
+      ray.dir_y[filled] = static_cast<float>(d.y());
+      ray.dir_z[filled] = static_cast<float>(d.z());
+      ray.tnear[filled] = 0.0f;
+      // Stop short of the point itself, where the ray is still kSurfaceClearance
+      // off its surface's plane: a ray that grazes the surface (the camera
+      // within a hair of its plane) would otherwise meet the surface it ends on.
+      const double short_of = std::max(1e-4, kSurfaceClearance / towards);
+      ray.tfar[filled] = static_cast<float>(std::max(0.0, 1.0 - short_of));
+      if (++filled == kPacket) trace();
+    };
+    // Whether fewer than at_least can be seen (after the rays on their way).
+    const auto below = [&]() {
+      trace();
+      const int could_face = facing + total - looked_at;
+      const double could_see = could_face > 0 ? static_cast<double>(could_face - not_seen) / could_face : 0.0;
+      if (could_see >= at_least) return false;
+      if (exact != nullptr) *exact = looked_at == total;
+      return true;
+    };
+    const auto could_see = [&]() {
+      const int could_face = facing + total - looked_at;
+      return could_face > 0 ? static_cast<double>(could_face - not_seen) / could_face : 0.0;
+    };
+    if (track) {
+      for (std::size_t w = 0; w < words; ++w) {
+        for (std::uint64_t m = earlier[w]; m != 0; m &= m - 1) {
+          const int sample = static_cast<int>(w * 64) + __builtin_ctzll(m);
+          if (sample >= total) continue;
+          look_at(sample);
+          if (filled == 0 && below()) return could_see();  // a packet has just gone
+        }
+      }
+      if (below()) return could_see();
+    }
     for (int p = 0; p < (bounded ? 1 << bits : blocks); ++p) {
       int q = p;
       if (bounded) {
@@ -495,47 +573,13 @@ struct Renderer::Impl {
         for (int bit = 0; bit < bits; ++bit) q |= ((p >> bit) & 1) << (bits - 1 - bit);
         if (q >= blocks) continue;
       }
-      const int first = q * kBlock, end = std::min(total, first + kBlock);
-      for (int s = first; s < end; ++s) {
-        const WorldPoint& w = target.points[static_cast<std::size_t>(s)];
-        const double towards = w.n.dot(o - w.p);
-        if (towards <= 0.0) continue;
-        ++facing;
-        if (!all_in_view) {
-          const Eigen::Vector3d pc = cMw * w.p;
-          const double u = k.fx * pc.x() / pc.z() + k.cx, v = k.fy * pc.y() / pc.z() + k.cy;
-          if (pc.z() < sensor.min_depth || pc.z() > sensor.max_depth || u < 0.0 || v < 0.0 || u > k.width - 1.0 ||
-              v > k.height - 1.0) {
-            ++missed;
-            continue;
-          }
-        }
-        if (!cast) continue;
-        const Eigen::Vector3d d = w.p - o;
-        valid[filled] = -1;
-        ray.dir_x[filled] = static_cast<float>(d.x());
-        ray.dir_y[filled] = static_cast<float>(d.y());
-        ray.dir_z[filled] = static_cast<float>(d.z());
-        ray.tnear[filled] = 0.0f;
-        // Stop short of the point itself, where the ray is still kSurfaceClearance
-        // off its surface's plane: a ray that grazes the surface (the camera
-        // within a hair of its plane) would otherwise meet the surface it ends on.
-        const double short_of = std::max(1e-4, kSurfaceClearance / towards);
-        ray.tfar[filled] = static_cast<float>(std::max(0.0, 1.0 - short_of));
-        if (++filled == kPacket) trace();
+      for (int sample = q * kBlock; sample < std::min(total, (q + 1) * kBlock); ++sample) {
+        if (!track || (done[static_cast<std::size_t>(sample) / 64] >> (sample % 64) & 1u) == 0) look_at(sample);
       }
-      if (!bounded) continue;
-      if (filled > 0) trace();
-      looked_at += end - first;
-      const int could_face = facing + total - looked_at;
-      const double could_see = could_face > 0 ? static_cast<double>(could_face - missed) / could_face : 0.0;
-      if (could_see < at_least) {
-        if (exact != nullptr) *exact = false;
-        return could_see;
-      }
+      if (bounded && below()) return could_see();
     }
-    if (filled > 0) trace();
-    return facing > 0 ? static_cast<double>(facing - missed) / facing : 0.0;
+    trace();
+    return facing > 0 ? static_cast<double>(facing - not_seen) / facing : 0.0;
   }
 };
 
@@ -749,10 +793,12 @@ std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometr
 }
 
 std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometry3d>& poses,
-                                                const std::vector<double>& at_least, std::vector<char>& exact) const {
-  if (at_least.size() != poses.size()) {
-    throw std::invalid_argument("renderer: " + std::to_string(at_least.size()) + " thresholds for " +
-                                std::to_string(poses.size()) + " poses");
+                                                const std::vector<double>& at_least, std::vector<char>& exact,
+                                                std::vector<std::vector<std::uint64_t>>* missed) const {
+  if (at_least.size() != poses.size() || (missed != nullptr && missed->size() != poses.size())) {
+    throw std::invalid_argument("renderer: " + std::to_string(at_least.size()) + " thresholds and " +
+                                std::to_string(missed != nullptr ? missed->size() : poses.size()) +
+                                " sets of samples for " + std::to_string(poses.size()) + " poses");
   }
   for (const Eigen::Isometry3d& wMc : poses) {
     if (!wMc.matrix().allFinite()) throw std::invalid_argument("renderer: a camera pose is not finite");
@@ -763,7 +809,8 @@ std::vector<double> Renderer::visible_fractions(const std::vector<Eigen::Isometr
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses.size()), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       bool whole = true;
-      fractions[i] = impl_->visible_fraction(samples, poses[i], scenario_.sensor, at_least[i], &whole);
+      fractions[i] = impl_->visible_fraction(samples, poses[i], scenario_.sensor, at_least[i], &whole,
+                                             missed != nullptr ? &(*missed)[i] : nullptr);
       exact[i] = whole ? 1 : 0;
     }
   });

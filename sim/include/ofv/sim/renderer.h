@@ -95,17 +95,21 @@ class Renderer {
   [[nodiscard]] std::vector<double> visible_fractions(const std::vector<Eigen::Isometry3d>& poses) const;
   /**
    * \brief The same where only fractions of at least `at_least[k]` matter
-   *        for pose k: its rays go in packets spread over the object's
-   *        surface and stop once fewer than that can be seen. Then its entry
-   *        is the fraction that could still be seen (an upper bound, below
-   *        `at_least[k]`) and `exact[k]` is 0; otherwise the entry is
-   *        visible_fractions()' and `exact[k]` is 1. A threshold of 0 or
-   *        less never stops the rays.
+   *        for pose k: its rays stop once fewer than that can be seen. Then
+   *        its entry is the fraction that could still be seen, an upper
+   *        bound below `at_least[k]`, and `exact[k]` is 0; otherwise the
+   *        entry is visible_fractions()' and `exact[k]` is 1. The samples go
+   *        in blocks spread over the object's surface; with `missed`, pose
+   *        k's samples set in `(*missed)[k]` (a bitset over the object's
+   *        samples: those an earlier call found not seen from a view near
+   *        this one) go first, and `(*missed)[k]` becomes those this call
+   *        found not seen (left as it was where the threshold is 0 or
+   *        less). A threshold of 0 or less never stops the rays.
    * \throws std::invalid_argument when a pose is not finite or the sizes differ.
    */
   [[nodiscard]] std::vector<double> visible_fractions(const std::vector<Eigen::Isometry3d>& poses,
-                                                      const std::vector<double>& at_least,
-                                                      std::vector<char>& exact) const;
+                                                      const std::vector<double>& at_least, std::vector<char>& exact,
+                                                      std::vector<std::vector<std::uint64_t>>* missed = nullptr) const;
 
   /// \brief The object's area-weighted surface centroid (truth()'s) at the current time [m].
   [[nodiscard]] Eigen::Vector3d object_centroid() const;
