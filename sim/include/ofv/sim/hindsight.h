@@ -37,9 +37,10 @@
  * are made. A view keeps its value while no moving body comes near its cone
  * of sight to the object, so a still scene values each view once. A first
  * scan of the steps finds the best view at each (the unlimited bound): the
- * views best at the step before first, then the others only as far as they
- * could beat those (their rays stop once they cannot; none when a view sees
- * all). Then the programme runs twice: keeping only the 64 best totals at
+ * views best at the step before first, then the others in batches, each
+ * only as far as it could beat the best so far (its rays stop once it
+ * cannot, those to the samples it last found hidden first), until a view
+ * sees all. Then the programme runs twice: keeping only the 64 best totals at
  * each step, which gives a path and its total; then keeping every state
  * whose total, with the best view's value at every step after it, can still
  * reach that total. No path through the others can beat the first one, so
