@@ -711,7 +711,8 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
         double need = kUnreached;
         if (!beam && !stands_for[v]) {
           need = floor - slack - after[si] - came[v];
-          if (known[si][v] == kAtMost && value[si][v] < need) continue;  // cannot reach the floor
+          // It cannot reach the floor: even the step's best value would not, or its bound does not.
+          if (need > upper[si] || (known[si][v] == kAtMost && value[si][v] < need)) continue;
         }
         views.push_back(static_cast<int>(v));
         at_least.push_back(need);
