@@ -542,29 +542,29 @@ struct Renderer::Impl {
       ray.tfar[filled] = static_cast<float>(std::max(0.0, 1.0 - short_of));
       if (++filled == kPacket) trace();
     };
-    // Whether fewer than at_least can be seen (after the rays on their way).
-    const auto below = [&]() {
-      trace();
-      const int could_face = facing + total - looked_at;
-      const double could_see = could_face > 0 ? static_cast<double>(could_face - not_seen) / could_face : 0.0;
-      if (could_see >= at_least) return false;
-      if (exact != nullptr) *exact = looked_at == total;
-      return true;
-    };
+    // The fraction that could still be seen, every sample not yet looked at
+    // taken as facing and seen; whether it is below at_least once the rays
+    // on their way are traced (then the value is that bound).
     const auto could_see = [&]() {
       const int could_face = facing + total - looked_at;
       return could_face > 0 ? static_cast<double>(could_face - not_seen) / could_face : 0.0;
     };
+    const auto can_stop = [&]() {
+      trace();
+      if (could_see() >= at_least) return false;
+      if (exact != nullptr) *exact = looked_at == total;
+      return true;
+    };
     if (track) {
       for (std::size_t w = 0; w < words; ++w) {
-        for (std::uint64_t m = earlier[w]; m != 0; m &= m - 1) {
-          const int sample = static_cast<int>(w * 64) + __builtin_ctzll(m);
-          if (sample >= total) continue;
+        for (int bit = 0; bit < 64 && earlier[w] != 0; ++bit) {
+          const int sample = static_cast<int>(w * 64) + bit;
+          if ((earlier[w] >> bit & 1u) == 0 || sample >= total) continue;
           look_at(sample);
-          if (filled == 0 && below()) return could_see();  // a packet has just gone
+          if (filled == 0 && can_stop()) return could_see();  // a packet has just gone
         }
       }
-      if (below()) return could_see();
+      if (can_stop()) return could_see();
     }
     for (int p = 0; p < (bounded ? 1 << bits : blocks); ++p) {
       int q = p;
@@ -576,7 +576,7 @@ struct Renderer::Impl {
       for (int sample = q * kBlock; sample < std::min(total, (q + 1) * kBlock); ++sample) {
         if (!track || (done[static_cast<std::size_t>(sample) / 64] >> (sample % 64) & 1u) == 0) look_at(sample);
       }
-      if (bounded && below()) return could_see();
+      if (bounded && can_stop()) return could_see();
     }
     trace();
     return facing > 0 ? static_cast<double>(facing - not_seen) / facing : 0.0;
