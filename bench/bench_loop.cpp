@@ -2,8 +2,8 @@
 // + estimate + control + robot step + the per-frame scores) on the default
 // scenario: steps per second over its whole episode (4 s; the hand comes into
 // view at 1.5 s and stays: a one-second episode measured only the quiet
-// start), >= 30 keeps up with the sensor; and the throughput of `ofv compare`
-// in episodes per minute.
+// start), >= 30 keeps up with the sensor; the throughput of `ofv compare` in
+// episodes per minute; and the hindsight planner's time.
 #include "ofv/loop/compare.h"
 #include "ofv/loop/episode.h"
 
@@ -80,5 +80,32 @@ BENCHMARK(BM_CompareThroughput)
     ->Unit(benchmark::kSecond)
     ->UseRealTime()
     ->Iterations(1);
+
+// The hindsight planner (method hindsight) on seed 0 of a scenario at its
+// defaults, the episode that follows the plan included (a small part):
+// `plan_s` the planning time, `evaluations` the visibility evaluations made
+// (views x steps at most). Arg: 0 sweep (5 s at 30 Hz, an arm crossing), 1
+// moving-object (5 s, the object sliding), 2 cloth-occluder (4 s, a waving
+// cloth and a hand: the costliest of the built-in scenarios).
+void BM_HindsightPlan(benchmark::State& state) {
+  const char* names[] = {"sweep", "moving-object", "cloth-occluder"};
+  ofv::EpisodeSetup setup;
+  try {
+    setup = ofv::resolve_episode(ofv::sim::load_scenario(names[state.range(0)]), {{"method", "hindsight"}, {"seed", "0"}});
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  double plan_s = 0.0;
+  long evaluations = 0;
+  for (auto _ : state) {
+    const ofv::EpisodeOutcome o = ofv::run_episode(setup);
+    plan_s += o.metrics.hindsight->plan_s;
+    evaluations += o.metrics.hindsight->evaluations;
+  }
+  state.counters["plan_s"] = plan_s / static_cast<double>(state.iterations());
+  state.counters["evaluations"] = static_cast<double>(evaluations) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_HindsightPlan)->DenseRange(0, 2)->ArgName("scenario")->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
