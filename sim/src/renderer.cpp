@@ -691,14 +691,14 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
   std::vector<Eigen::Vector3d> column_term(static_cast<std::size_t>(k.width));
   for (int u = 0; u < k.width; ++u) column_term[static_cast<std::size_t>(u)] = R.col(0) * ((u - k.cx) / k.fx);
   const Eigen::Vector3d last = R.col(2);
-  // Coherent rays of 8 neighbouring pixels are traced as one packet.
+  // Coherent rays of 16 neighbouring pixels are traced as one packet.
   for_each_band(k.height, [&](int row0, int row1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    constexpr int kPacket = 8;
-    alignas(32) int valid[kPacket];
-    RTCRayHit8 rh;
+    constexpr int kPacket = 16;
+    alignas(64) int valid[kPacket];
+    RTCRayHit16 rh;
     // What Embree reads and never writes, set once.
     for (int j = 0; j < kPacket; ++j) {
       rh.ray.org_x[j] = static_cast<float>(o.x());
@@ -724,7 +724,7 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
           rh.ray.tfar[j] = tfar;
           rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect8(valid, impl_->scene, &context, &rh);
+        rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (int j = 0; j < kPacket && u0 + j < k.width; ++j) {
           const unsigned geom = rh.hit.geomID[j];
           if (geom == RTC_INVALID_GEOMETRY_ID) continue;
