@@ -2,6 +2,7 @@
 #include "ofv/perception/scores.h"
 
 #include "ofv/perception/cloud.h"
+#include "parallel.h"
 #include "point_grid.h"
 
 #include <algorithm>
@@ -68,16 +69,34 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
   std::vector<Votes> votes;
   std::unordered_map<std::size_t, std::vector<std::pair<std::uint16_t, int>>> more;
   std::vector<int> counts;
-  std::uint64_t last_key = ~std::uint64_t{0};  // neighbouring pixels mostly share a cell
-  std::size_t current = 0;  // its cell
-  for (int v = 0; v < k.height; v += stride) {
+  // Each sampled pixel's point and cell, the rows in parallel; then the
+  // votes in the pixels' order (the cells' sums as one loop would add them).
+  const int rows = (k.height + stride - 1) / stride, columns = (k.width + stride - 1) / stride;
+  constexpr std::uint64_t kNoPoint = ~std::uint64_t{0};
+  std::vector<std::uint64_t> keys(static_cast<std::size_t>(rows) * static_cast<std::size_t>(columns), kNoPoint);
+  std::vector<Eigen::Vector3f> points(keys.size());
+  detail::for_each_index(static_cast<std::size_t>(rows), 8, [&](std::size_t row) {
+    const int v = static_cast<int>(row) * stride;
     for (int u = 0; u < k.width; u += stride) {
       const std::size_t i = frame.index(u, v);
       const float z = frame.depth[i];
       if (!(z > 0.0f) || !std::isfinite(z) || z > static_cast<float>(max_depth)) continue;
       const Eigen::Vector3f pc(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
-      const Eigen::Vector3f pw = wRc * pc + wtc;
-      const std::uint64_t key = detail::cell_key(detail::cell_of(pw, inv_voxel_));
+      const std::size_t at = row * static_cast<std::size_t>(columns) + static_cast<std::size_t>(u / stride);
+      points[at] = wRc * pc + wtc;
+      keys[at] = detail::cell_key(detail::cell_of(points[at], inv_voxel_));
+    }
+  });
+  std::uint64_t last_key = kNoPoint;  // neighbouring pixels mostly share a cell
+  std::size_t current = 0;  // its cell
+  for (int v = 0; v < k.height; v += stride) {
+    for (int u = 0; u < k.width; u += stride) {
+      const std::size_t i = frame.index(u, v);
+      const std::size_t at = static_cast<std::size_t>(v / stride) * static_cast<std::size_t>(columns) +
+                             static_cast<std::size_t>(u / stride);
+      const std::uint64_t key = keys[at];
+      if (key == kNoPoint) continue;
+      const Eigen::Vector3f& pw = points[at];
       if (key != last_key) {
         int& cell = index->cells.find_or_insert(key);
         if (cell < 0) {
@@ -175,11 +194,19 @@ PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult
   std::vector<Eigen::Vector3f> object_points, occluder_points;
   std::size_t object_voxels = 0, object_right = 0, occluder_voxels = 0, occluder_right = 0;
   const bool lost = result.status == TrackingStatus::Lost;
-  for (std::size_t i = 0; i < result.voxels.size() && !lost; ++i) {
-    const SupervoxelClass cls = result.supervoxels[static_cast<std::size_t>(result.voxel_owner[i])].label;
+  const auto class_of = [&](std::size_t i) {
+    return result.supervoxels[static_cast<std::size_t>(result.voxel_owner[i])].label;
+  };
+  std::vector<std::uint16_t> truth_of(lost ? 0 : result.voxels.size(), kPixelNone);  // each voxel's cell's label
+  detail::for_each_index(truth_of.size(), 256, [&](std::size_t i) {
+    if (class_of(i) == SupervoxelClass::Object || class_of(i) == SupervoxelClass::Occluder) {
+      truth_of[i] = cells.label_at(result.voxels[i]);
+    }
+  });
+  for (std::size_t i = 0; i < truth_of.size(); ++i) {
+    const SupervoxelClass cls = class_of(i);
     if (cls != SupervoxelClass::Object && cls != SupervoxelClass::Occluder) continue;
-    const int c = cells.find(result.voxels[i]);
-    const std::uint16_t label = c < 0 ? std::uint16_t{kPixelNone} : all[static_cast<std::size_t>(c)].label;
+    const std::uint16_t label = truth_of[i];
     if (cls == SupervoxelClass::Object) {
       ++object_voxels;
       object_right += label == kPixelObject ? 1u : 0u;
@@ -198,11 +225,14 @@ PerceptionScores score_perception(const RgbdFrame& frame, const PerceptionResult
   const auto near = [voxel](const detail::PointGrid& grid, const Eigen::Vector3f& p) {
     return grid.any_within(p, static_cast<float>(voxel), [](int) { return true; });
   };
-  std::size_t object_found = 0, occluder_found = 0;
-  for (const VoxelLabels::Cell& c : all) {
-    object_found += c.label == kPixelObject && near(object_grid, c.mean) ? 1u : 0u;
-    occluder_found += is_occluder(c.label) && in_sphere(c.mean) && near(occluder_grid, c.mean) ? 1u : 0u;
-  }
+  std::vector<char> found(all.size(), 0);  // 1: an object cell found, 2: an occluder cell found
+  detail::for_each_index(all.size(), 256, [&](std::size_t i) {
+    const VoxelLabels::Cell& c = all[i];
+    if (c.label == kPixelObject && near(object_grid, c.mean)) found[i] = 1;
+    if (is_occluder(c.label) && in_sphere(c.mean) && near(occluder_grid, c.mean)) found[i] = 2;
+  });
+  const auto object_found = static_cast<std::size_t>(std::count(found.begin(), found.end(), 1));
+  const auto occluder_found = static_cast<std::size_t>(std::count(found.begin(), found.end(), 2));
   s.object_precision = ratio(object_right, object_voxels);
   s.object_recall = ratio(object_found, s.object_cells);
   s.occluder_precision = ratio(occluder_right, occluder_voxels);
