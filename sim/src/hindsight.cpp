@@ -5,6 +5,7 @@
 #include "ofv/settings_table.h"
 #include "ofv/sim/renderer.h"
 #include "ofv/view_methods.h"
+#include "bit_reversal.h"
 #include "sight_cone.h"
 
 #include <tbb/blocked_range.h>
@@ -417,11 +418,14 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   // first to the samples it last found not seen (`not_seen`, a bitset a view).
   std::vector<std::vector<std::uint64_t>> not_seen(nv);
   long renderer_step = -1;  // the renderer is at this step's time
+  const auto at_step = [&](long i) {
+    if (renderer_step != i) renderer.set_time(plan.times[static_cast<std::size_t>(i)]);
+    renderer_step = i;
+  };
   const auto cast = [&](long i, const std::vector<int>& views, const std::vector<double>& at_least) {
     if (views.empty()) return;
     const auto si = static_cast<std::size_t>(i);
-    if (renderer_step != i) renderer.set_time(plan.times[si]);
-    renderer_step = i;
+    at_step(i);
     std::vector<Eigen::Isometry3d> poses;
     poses.reserve(views.size());
     for (const int v : views) poses.push_back(looking_at(position(static_cast<std::size_t>(v), i), c[si], wMc_start));
@@ -448,14 +452,9 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
   // before first, then spread over the sphere), each batch only as far as
   // it could beat the best of the batches before, until one sees all.
   constexpr std::size_t kProbes = 32, kBatch = 1024;
-  std::vector<int> spread(nv);  // a view's rank in an order spread over the sphere: bit-reversed indices
-  int bits = 0;
-  while ((std::size_t{1} << bits) < nv) ++bits;
-  for (std::size_t v = 0; v < nv; ++v) {
-    std::size_t r = 0;
-    for (int bit = 0; bit < bits; ++bit) r |= ((v >> bit) & 1u) << (bits - 1 - bit);
-    spread[v] = static_cast<int>(r);
-  }
+  std::vector<std::size_t> spread(nv);  // a view's rank in an order spread over the sphere: bit-reversed indices
+  const int bits = detail::bits_for(nv);
+  for (std::size_t v = 0; v < nv; ++v) spread[v] = detail::bit_reversed(v, bits);
   std::vector<Changes> changes_at(static_cast<std::size_t>(steps));  // since the step before
   std::vector<std::vector<signed char>> still(static_cast<std::size_t>(steps), std::vector<signed char>(nv, -1));
   const auto unchanged = [&](long i, std::size_t v) {
@@ -490,10 +489,10 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     double best = kUnreached;
     tbb::parallel_for(0, n, [&](int v) {
       const auto sv = static_cast<std::size_t>(v);
-      if (i > 0 && known[si - 1][sv] != kUnknown && unchanged(i, sv)) {
-        const bool looking = known[si - 1][sv] == kLooking || known[si - 1][sv] == kAtMost;
+      const char held = i > 0 ? known[si - 1][sv] : static_cast<char>(kUnknown);
+      if ((held == kLooking || held == kAtMost) && unchanged(i, sv)) {
         value[si][sv] = value[si - 1][sv];
-        known[si][sv] = looking ? known[si - 1][sv] : static_cast<char>(kUnknown);
+        known[si][sv] = held;
       }
     });
     for (std::size_t v = 0; v < nv; ++v) {
@@ -506,12 +505,16 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
     const auto last_value = [&](int v) {
       return i > 0 && known[si - 1][static_cast<std::size_t>(v)] != kUnknown ? value[si - 1][static_cast<std::size_t>(v)] : -1.0;
     };
-    std::sort(order.begin(), order.end(), [&](int u, int v) {
+    const auto first = [&](int u, int v) {
       const double lu = last_value(u), lv = last_value(v);
       return lu > lv || (lu == lv && spread[static_cast<std::size_t>(u)] < spread[static_cast<std::size_t>(v)]);
-    });
+    };
+    // The probes in order, the others sorted only if they are needed.
+    const auto probe_end = order.begin() + static_cast<std::ptrdiff_t>(std::min(kProbes, order.size()));
+    std::partial_sort(order.begin(), probe_end, order.end(), first);
     for (std::size_t k = 0; k < order.size() && best < 1.0;) {
       const bool probes = k == 0;
+      if (k == kProbes) std::sort(probe_end, order.end(), first);
       const std::size_t end = std::min(order.size(), k + (probes ? kProbes : kBatch));
       std::vector<int> batch;
       for (; k < end; ++k) {
@@ -562,8 +565,7 @@ HindsightPlan plan_hindsight(const Scenario& scenario, const Eigen::Isometry3d& 
       poses.push_back(aimed(on_the_way(direct[g], i), i, &turned));
     }
     if (!poses.empty()) {
-      if (renderer_step != i) renderer.set_time(plan.times[si]);
-      renderer_step = i;
+      at_step(i);
       const std::vector<double> seen = renderer.visible_fractions(poses);
       plan.evaluations += static_cast<long>(seen.size());
       for (std::size_t k = 0; k < seen.size(); ++k) {

@@ -1,5 +1,6 @@
 // Embree ray casting of a scenario: RGB-D frames, labels and ground truth.
 #include "ofv/sim/renderer.h"
+#include "bit_reversal.h"
 #include "ofv/constants.h"
 #include "sight_cone.h"
 
@@ -480,8 +481,7 @@ struct Renderer::Impl {
       missed->assign(words, 0);
       done.assign(words, 0);
     }
-    int bits = 0;
-    while (bounded && (1 << bits) < blocks) ++bits;
+    const int bits = bounded ? detail::bits_for(static_cast<std::size_t>(blocks)) : 0;
     int facing = 0, not_seen = 0, looked_at = 0;
     const auto found = [&](int sample) {
       ++not_seen;
@@ -567,12 +567,8 @@ struct Renderer::Impl {
       if (can_stop()) return could_see();
     }
     for (int p = 0; p < (bounded ? 1 << bits : blocks); ++p) {
-      int q = p;
-      if (bounded) {
-        q = 0;
-        for (int bit = 0; bit < bits; ++bit) q |= ((p >> bit) & 1) << (bits - 1 - bit);
-        if (q >= blocks) continue;
-      }
+      const int q = bounded ? static_cast<int>(detail::bit_reversed(static_cast<std::size_t>(p), bits)) : p;
+      if (q >= blocks) continue;
       for (int sample = q * kBlock; sample < std::min(total, (q + 1) * kBlock); ++sample) {
         if (!track || (done[static_cast<std::size_t>(sample) / 64] >> (sample % 64) & 1u) == 0) look_at(sample);
       }
