@@ -34,6 +34,8 @@ constexpr double kFlat = 0.05;
 constexpr int kMinPatches = 8;
 // Ok steps whose residuals set what a step's may be (max_residual_ratio).
 constexpr std::size_t kResiduals = 9;
+// Rounds of restarts at most (OdometrySettings::restart_distance).
+constexpr double kRestartRounds = 10.0;
 
 cv::Ptr<cv::rgbd::Odometry> make_odometry(const OdometrySettings& s, const CameraIntrinsics& k) {
   cv::Mat K = (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
@@ -103,6 +105,33 @@ CameraIntrinsics reduced(const CameraIntrinsics& k, int factor) {
 /// The rotation's angle [rad].
 double angle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 
+/// OpenCV's 4x4 motion as an isometry. OpenCV composes its increments
+/// without re-orthonormalising: the rotation drifts off SO(3) and, composed
+/// frame after frame, scales the pose; the nearest rotation is taken.
+Eigen::Isometry3d isometry(const Eigen::Matrix4d& T) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.topLeftCorner<3, 3>(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+  if (R.determinant() < 0.0) {
+    Eigen::Matrix3d U = svd.matrixU();
+    U.col(2) = -U.col(2);
+    R = U * svd.matrixV().transpose();
+  }
+  Eigen::Isometry3d M = Eigen::Isometry3d::Identity();
+  M.linear() = R;
+  M.translation() = T.topRightCorner<3, 1>();
+  return M;
+}
+
+/// The share `s` of the motion M: the rotation's angle and the translation
+/// scaled by it (the screw's for the small motions between frames).
+Eigen::Isometry3d fraction(const Eigen::Isometry3d& M, double s) {
+  const Eigen::AngleAxisd turn(M.linear());
+  Eigen::Isometry3d F = Eigen::Isometry3d::Identity();
+  F.linear() = Eigen::AngleAxisd(turn.angle() * s, turn.axis()).toRotationMatrix();
+  F.translation() = M.translation() * s;
+  return F;
+}
+
 }  // namespace
 
 struct Odometry::Impl {
@@ -116,6 +145,7 @@ struct Odometry::Impl {
   Eigen::Isometry3d wMk = Eigen::Isometry3d::Identity();  // the reference frame's pose
   Eigen::Isometry3d kMc = Eigen::Isometry3d::Identity();  // the last good pose in the reference frame
   Eigen::Isometry3d velocity = Eigen::Isometry3d::Identity();  // the last step's motion when it was Ok
+  int unknown = 0;  // steps since the last Ok or first frame: the pose is that many frames old
   std::deque<double> residuals;  // of the last kResiduals Ok steps, oldest first
   cv::Ptr<cv::rgbd::OdometryFrame> reference;
 
@@ -182,6 +212,64 @@ struct Odometry::Impl {
       }
     }
     return cv::rgbd::OdometryFrame::create(grey, depth, mask);
+  }
+
+  /// OpenCV's motion of `current` in the reference's frame from the start
+  /// `guess` (the same frames: OpenCV keeps what it computed of them), not
+  /// yet re-orthonormalised; false when it finds none or throws.
+  [[nodiscard]] bool match(cv::Ptr<cv::rgbd::OdometryFrame>& current, const Eigen::Isometry3d& guess,
+                           Eigen::Matrix4d& T) {
+    cv::Mat init(4, 4, CV_64FC1);
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) init.at<double>(r, c) = guess.matrix()(r, c);
+    }
+    cv::Mat Rt;
+    if (!odometry->compute(current, reference, Rt, init) || Rt.rows != 4 || Rt.cols != 4) return false;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) T(r, c) = Rt.at<double>(r, c);
+    }
+    return true;
+  }
+
+  /// Matches `current` again from starts restart_distance from `motion` (in
+  /// the reference's frame) along each of the camera's axes, and again
+  /// around the best while one fits the reference better (a lower RMS of the
+  /// matching pixels than `residual`, `motion`'s, with the overlap and
+  /// inliers a step needs), as far as max_translation (kRestartRounds at
+  /// most). Whether one did: the best is then in `motion`.
+  bool restart(cv::Ptr<cv::rgbd::OdometryFrame>& current, Eigen::Isometry3d& motion, double residual) {
+    const int rounds =
+        static_cast<int>(std::min(kRestartRounds, std::ceil(settings.max_translation / settings.restart_distance)));
+    bool better = false;
+    for (int round = 0; round < rounds; ++round) {
+      const Eigen::Isometry3d around = motion;
+      bool moved = false;
+      for (int axis = 0; axis < 3; ++axis) {
+        for (const double side : {-1.0, 1.0}) {
+          Eigen::Isometry3d start = around;
+          start.translation()(axis) += side * settings.restart_distance;
+          Eigen::Matrix4d T;
+          try {
+            if (!match(current, start, T) || !T.allFinite()) continue;
+          } catch (const cv::Exception&) {
+            continue;
+          }
+          const Eigen::Isometry3d other = isometry(T);
+          OdometryDiagnostics fit;
+          cv::Mat pixels;
+          inliers(*current, *reference, other, fit, pixels);
+          if (fit.overlap_fraction >= settings.min_overlap_fraction &&
+              fit.inlier_fraction >= settings.min_inlier_fraction && fit.residual < residual) {
+            motion = other;
+            residual = fit.residual;
+            moved = true;
+          }
+        }
+      }
+      if (!moved) break;
+      better = true;
+    }
+    return better;
   }
 
   /// Whether a step's residual is more than max_residual_ratio times the
@@ -318,6 +406,7 @@ void Odometry::reset() {
   impl_->reference.release();
   impl_->wMc = impl_->wMk = impl_->kMc = impl_->velocity = Eigen::Isometry3d::Identity();
   impl_->residuals.clear();
+  impl_->unknown = 0;
 }
 
 const Eigen::Isometry3d& Odometry::wMc() const { return impl_->wMc; }
@@ -339,6 +428,7 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
   OdometryResult result;
   const auto finish = [&](OdometryStatus status) {
     if (status != OdometryStatus::Ok) m.velocity = Eigen::Isometry3d::Identity();
+    m.unknown = m.started && status != OdometryStatus::Ok && status != OdometryStatus::FirstFrame ? m.unknown + 1 : 0;
     result.status = status;
     result.wMc = m.wMc;
     result.diagnostics.ms =
@@ -380,63 +470,58 @@ OdometryResult Odometry::step(const RgbdFrame& frame, const ObjectHint& object) 
   // The first guess: the last step's motion again from the last pose (the
   // camera moves smoothly), or the last pose.
   const Eigen::Isometry3d guess = m.settings.constant_velocity ? m.kMc * m.velocity : m.kMc;
-  cv::Mat init(4, 4, CV_64FC1);
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) init.at<double>(r, c) = guess.matrix()(r, c);
-  }
-  cv::Mat Rt;
-  bool ok = false;
+  Eigen::Matrix4d T;
   try {
-    ok = m.odometry->compute(current, m.reference, Rt, init);
+    d.converged = m.match(current, guess, T);
   } catch (const cv::Exception&) {
     return finish(OdometryStatus::Failed);  // e.g. too few points for a level of the pyramid
   }
-  d.converged = ok && Rt.rows == 4 && Rt.cols == 4;
   // The frame had pixels enough: no motion that fits means it does not fit the reference.
   if (!d.converged) return finish(OdometryStatus::Implausible);
-
-  Eigen::Matrix4d T;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) T(r, c) = Rt.at<double>(r, c);
-  }
   if (!T.allFinite()) {
     d.translation = d.rotation = std::numeric_limits<double>::quiet_NaN();
     return finish(OdometryStatus::Implausible);
   }
-  // OpenCV composes its increments without re-orthonormalising: the
-  // rotation drifts off SO(3) and, composed frame after frame, scales the pose.
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   d.orthonormality = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d Rn = svd.matrixU() * svd.matrixV().transpose();
-  if (Rn.determinant() < 0.0) {
-    Eigen::Matrix3d U = svd.matrixU();
-    U.col(2) = -U.col(2);
-    Rn = U * svd.matrixV().transpose();
-  }
-  Eigen::Isometry3d kMc = Eigen::Isometry3d::Identity();
-  kMc.linear() = Rn;
-  kMc.translation() = T.topRightCorner<3, 1>();
-
-  const Eigen::Isometry3d wMc = m.wMk * kMc;
-  const Eigen::Isometry3d motion = m.wMc.inverse() * wMc;  // from the last good pose
-  d.translation = motion.translation().norm();
-  d.rotation = angle(motion.linear()) / kDegree;
+  Eigen::Isometry3d kMc = isometry(T);
+  // Whether the motion kMc is one the camera can have made and that fits
+  // the reference (the checks' measures in d; `matching` its matching pixels).
   cv::Mat matching;
-  m.inliers(*current, *m.reference, kMc, d, matching);
-  if (d.translation > m.settings.max_translation || d.rotation > m.settings.max_rotation ||
-      d.overlap_fraction < m.settings.min_overlap_fraction || d.inlier_fraction < m.settings.min_inlier_fraction ||
-      m.unlike_before(d.residual)) {
-    return finish(OdometryStatus::Implausible);
+  const auto judge = [&]() {
+    m.inliers(*current, *m.reference, kMc, d, matching);
+    const Eigen::Isometry3d motion = m.wMc.inverse() * m.wMk * kMc;  // from the last good pose
+    d.translation = motion.translation().norm();
+    d.rotation = angle(motion.linear()) / kDegree;
+    if (d.translation > m.settings.max_translation || d.rotation > m.settings.max_rotation ||
+        d.overlap_fraction < m.settings.min_overlap_fraction || d.inlier_fraction < m.settings.min_inlier_fraction ||
+        m.unlike_before(d.residual)) {
+      return OdometryStatus::Implausible;
+    }
+    d.match_constraint = std::numeric_limits<double>::quiet_NaN();
+    if (constrain) {
+      cv::Mat standing;
+      cv::bitwise_and(matching, away, standing);
+      d.match_constraint = m.constraint(depth, standing);
+      if (d.match_constraint < m.settings.min_still_constraint) return OdometryStatus::Degenerate;
+    }
+    return OdometryStatus::Ok;
+  };
+  OdometryStatus status = judge();
+  // The camera may have moved on while the pose was not known: the match,
+  // started far from the motion, can then stop in a wrong minimum that
+  // passes. Made again from around it, the best fit is judged instead.
+  if (status == OdometryStatus::Ok && m.unknown > 0 && m.settings.restart_distance > 0.0) {
+    const Eigen::Vector3d first = kMc.translation();
+    if (m.restart(current, kMc, d.residual)) status = judge();
+    d.restart_shift = (kMc.translation() - first).norm();
   }
-  if (constrain) {
-    cv::bitwise_and(matching, away, matching);
-    d.match_constraint = m.constraint(depth, matching);
-    if (d.match_constraint < m.settings.min_still_constraint) return finish(OdometryStatus::Degenerate);
-  }
+  if (status != OdometryStatus::Ok) return finish(status);
+  const Eigen::Isometry3d wMc = m.wMk * kMc;
+  const Eigen::Isometry3d motion = m.wMc.inverse() * wMc;
   m.wMc = wMc;
   m.kMc = kMc;
-  m.velocity = motion;
+  m.velocity = m.unknown == 0 ? motion : fraction(motion, 1.0 / (m.unknown + 1));  // a frame's motion
   m.residuals.push_back(d.residual);
   if (m.residuals.size() > kResiduals) m.residuals.pop_front();
   if (!m.settings.keyframe || kMc.translation().norm() > m.settings.keyframe_translation ||
@@ -497,7 +582,7 @@ FramePose frame_pose(const OdometryResult& r) {
   pose.diagnostics = {{"valid_fraction", d.valid_fraction}, {"masked_fraction", d.masked_fraction},
                       {"overlap_fraction", d.overlap_fraction}, {"inlier_fraction", d.inlier_fraction},
                       {"residual_m", d.residual},             {"still_constraint", d.still_constraint},
-                      {"match_constraint", d.match_constraint},
+                      {"match_constraint", d.match_constraint}, {"restart_shift_m", d.restart_shift},
                       {"translation_m", d.translation},       {"rotation_deg", d.rotation},
                       {"keyframe", d.keyframe ? 1.0 : 0.0},   {"ms", d.ms}};
   return pose;

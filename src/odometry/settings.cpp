@@ -52,8 +52,8 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
     bool_row(t, "keyframe", &S::keyframe,
              "match each frame against the last keyframe (false: against the previous frame, which drifts more)");
     bool_row(t, "constant_velocity", &S::constant_velocity,
-             "start each match from the last pose moved again by the last step's motion (false: from the last "
-             "pose)");
+             "start each match from the last pose moved again by the last step's motion (after steps without a "
+             "pose, its share of the motion over them; false: from the last pose)");
     number_row(t, "keyframe_translation", &S::keyframe_translation, "m",
                "a frame becomes the keyframe when the camera moved more than this from the last one", 0.0, 1.0, false);
     number_row(t, "keyframe_rotation", &S::keyframe_rotation, "deg",
@@ -81,6 +81,12 @@ const SettingsTable<OdometrySettings>& odometry_settings_table() {
                "a step after which the pixels that match the reference differ from it (RMS) by more than this "
                "times the median of the last 9 ok steps' is implausible: one surface taken for another (0: never)",
                0.0, 1000.0, false);
+    number_row(t, "restart_distance", &S::restart_distance, "m",
+               "after a step whose pose was not known, a match that passes is made again from starts this far from "
+               "it along each of the camera's axes, and around the best while one fits better (a lower residual "
+               "with the overlap and inliers needed; as far as max_translation, 10 rounds at most); the best is "
+               "judged instead (0: not made again)",
+               0.0, 1.0, false);
     number_row(t, "max_depth_diff", &S::max_depth_diff, "m",
                "pixels of the two frames match when their depths differ by at most this (OpenCV's maxDepthDiff)", 0.0,
                1.0, true);
