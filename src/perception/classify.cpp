@@ -122,7 +122,8 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
   // touch the object later is an occluder beyond where it touches (a hand
   // over a cloth's fold), and where it touches too if it was an occluder in
   // the previous frame (it came from elsewhere), until it has moved with the
-  // object (taken_by_hand()): then it is the holder.
+  // object (taken_by_hand()): then it is the holder. The plane's
+  // supervoxels the body touches (its base) are interacting too.
   const std::size_t n = r.supervoxels.size();
   const bool first = r.status == TrackingStatus::Initialised;
   if (first) {
@@ -212,6 +213,20 @@ void Perception::Impl::grow_holder(const PerceptionResult& r, const std::vector<
     if (body[static_cast<std::size_t>(r.voxel_owner[i])]) seen.push_back(r.voxels[i]);
   }
   if (!seen.empty()) {
+    // The holder's base on the support plane (a hand resting on a table of
+    // its colour) looks like the plane, which the body does not grow into;
+    // what of the plane, in the sphere, touches the body is interacting
+    // too, the body's base or the table under it (not grown from).
+    const auto contact = static_cast<float>(settings.contact_distance);
+    base_grid.build(seen, contact);
+    for (std::size_t i = 0; i < r.voxels.size(); ++i) {
+      const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
+      const SupervoxelInfo& s = r.supervoxels[owner];
+      if (interacting[owner] || object[owner] || !on_plane(s) || (s.centroid - c).norm() >= settings.r_sphere) {
+        continue;
+      }
+      if (base_grid.any_within(r.voxels[i], contact, [](int) { return true; })) interacting[owner] = 1;
+    }
     holder.swap(seen);
     holder_age = 0;
   } else if (++holder_age > settings.tracking.occlusion_memory_frames) {

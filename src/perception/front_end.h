@@ -284,6 +284,16 @@ struct Perception::Impl {
   /// labelled.cpp (Classes::Labels): every supervoxel cut where the frame's
   /// labels change; supervoxel_labels holds each piece's label.
   void split_by_labels(const RgbdFrame& frame);
+  /// labelled.cpp: every object supervoxel that holds voxels of the support
+  /// plane (plane_voxel()) and others cut in two, the plane's piece (not
+  /// the object's) after the supervoxels. Whether one was.
+  bool split_at_plane(const RgbdFrame& frame, const std::vector<char>& object);
+  detail::PointGrid base_grid;  // grow_holder(): the holder's body, for its base on the plane
+  /// labelled.cpp: sv's supervoxels replaced by pieces: `owner` each voxel's
+  /// piece, `whole` each piece's supervoxel before; a piece's centroid,
+  /// colour and count from its voxels, its normal its own where it is a flat
+  /// part of its supervoxel (else the supervoxel's).
+  void cut_supervoxels(const RgbdFrame& frame, std::vector<int> owner, const std::vector<int>& whole);
   /// labelled.cpp (Classes::Labels): the supervoxels labelled object (the
   /// first frame also fits the support plane); sets voxel_matched.
   std::vector<char> labelled_object(const RgbdFrame& frame, const PerceptionResult& r);

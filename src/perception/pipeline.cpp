@@ -71,8 +71,16 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   std::string why;
   voxel_revealed.assign(r.voxels.size(), 0);  // only track() finds revealed surface
   voxel_anchor.clear();                         // nor matches a remembered chromaticity
-  const std::vector<char> object =
+  const bool tracked = !labelled && initialised;
+  std::vector<char> object =
       labelled ? labelled_object(frame, r) : initialised ? track(frame, r) : select(frame, r, why);
+  // Tracking never takes the support plane's voxels; a supervoxel that
+  // straddles the object's foot and the plane gives them up.
+  if (tracked && split_at_plane(frame, object)) {
+    r.supervoxels = sv.supervoxels;
+    r.voxel_owner = sv.owner;
+    object.resize(r.supervoxels.size(), 0);
+  }
   set_status(frame, r, object, why);
   if (r.status != TrackingStatus::Lost) {
     remember(frame, r, object);
