@@ -284,10 +284,14 @@ struct Perception::Impl {
   /// labelled.cpp (Classes::Labels): every supervoxel cut where the frame's
   /// labels change; supervoxel_labels holds each piece's label.
   void split_by_labels(const RgbdFrame& frame);
-  /// labelled.cpp: every object supervoxel that holds voxels of the support
-  /// plane (plane_voxel()) and others cut in two, the plane's piece (not
-  /// the object's) after the supervoxels. Whether one was.
-  bool split_at_plane(const RgbdFrame& frame, const std::vector<char>& object);
+  /// labelled.cpp (tracking): the voxels of an object supervoxel that are not
+  /// the object's cut off, pieces after the supervoxels: those of the
+  /// support plane (plane_voxel()), and those that neither match the
+  /// remembered object (voxel_matched) nor were revealed and are unlike the
+  /// colour its matched voxels remember (voxel_anchor; twice
+  /// max_chroma_distance).
+  /// Whether one was.
+  bool split_off_others(const RgbdFrame& frame, const std::vector<char>& object);
   detail::PointGrid base_grid;  // grow_holder(): the holder's body, for its base on the plane
   /// labelled.cpp: sv's supervoxels replaced by pieces: `owner` each voxel's
   /// piece, `whole` each piece's supervoxel before; a piece's centroid,

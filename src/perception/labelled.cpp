@@ -2,13 +2,15 @@
 // frame's ground-truth labels in place of segmentation (supervoxels cut
 // where the labels change) and of tracking (the object is what is labelled
 // object); classify() takes the bodies' classes from supervoxel_labels.
-// Tracking: the support plane's voxels cut from the object's supervoxels.
+// Tracking: what is not the object's cut from its supervoxels.
 #include "front_end.h"
 
 #include "ofv/perception/scores.h"
 
 #include <Eigen/Eigenvalues>
 
+#include <array>
+#include <cstdint>
 #include <map>
 #include <utility>
 
@@ -36,30 +38,62 @@ void Perception::Impl::split_by_labels(const RgbdFrame& frame) {
   sv.touching.clear();  // only the default selection (Classes::Segmentation) reads it
 }
 
-bool Perception::Impl::split_at_plane(const RgbdFrame& frame, const std::vector<char>& object) {
-  if (!plane) return false;
-  // The voxels of the support plane (on it, of its colour) of an object
-  // supervoxel that has others too: a piece after the supervoxels.
-  std::vector<int> plane_voxels(sv.supervoxels.size(), 0);
-  std::vector<char> on(sv.voxels.size(), 0);
-  for (std::size_t i = 0; i < sv.voxels.size(); ++i) {
-    on[i] = plane_voxel(sv.voxels[i], sv.colours[i]) ? 1 : 0;
-    plane_voxels[static_cast<std::size_t>(sv.owner[i])] += on[i];
-  }
-  std::vector<int> whole(sv.supervoxels.size());
-  for (std::size_t k = 0; k < whole.size(); ++k) whole[k] = static_cast<int>(k);
-  std::vector<int> piece(sv.supervoxels.size(), -1);
-  for (std::size_t k = 0; k < piece.size(); ++k) {
-    if (object[k] && plane_voxels[k] > 0 && plane_voxels[k] < sv.supervoxels[k].voxel_count) {
-      piece[k] = static_cast<int>(whole.size());
-      whole.push_back(static_cast<int>(k));
+// A voxel of an object supervoxel is unlike the object when its
+// chromaticity is farther than this many max_chroma_distance from what its
+// matched voxels remember: a hand's is; one that mixes the object's colour
+// with the table's or a hand's at its edge (half way) stays. With 1, edge
+// voxels went too: a stretching box's recall by supervoxel 0.92 -> 0.87.
+constexpr double kUnlike = 2.0;
+
+bool Perception::Impl::split_off_others(const RgbdFrame& frame, const std::vector<char>& object) {
+  // Of an object supervoxel, the voxels of the support plane (on it, of its
+  // colour; kind 1) and those that neither match the remembered object nor
+  // were revealed and are unlike the colour its matched voxels remember
+  // (kind 2, kUnlike: a hand's, where VCCS merged it with the case's edge):
+  // a piece of each kind after the supervoxels, where some of it is left.
+  const std::size_t n = sv.supervoxels.size();
+  const bool colour = voxel_anchor.size() == sv.voxels.size();
+  std::vector<Eigen::Vector3f> anchor(n, Eigen::Vector3f::Zero());
+  std::vector<int> anchored(n, 0);
+  if (colour) {
+    for (std::size_t i = 0; i < sv.voxels.size(); ++i) {
+      const auto k = static_cast<std::size_t>(sv.owner[i]);
+      if (object[k] && voxel_matched[i]) {
+        anchor[k] += voxel_anchor[i];
+        ++anchored[k];
+      }
     }
   }
-  if (whole.size() == sv.supervoxels.size()) return false;
+  std::vector<std::uint8_t> kind(sv.voxels.size(), 0);
+  std::vector<std::array<int, 3>> count(n, {0, 0, 0});
+  for (std::size_t i = 0; i < sv.voxels.size(); ++i) {
+    const auto k = static_cast<std::size_t>(sv.owner[i]);
+    if (!object[k]) continue;
+    if (plane_voxel(sv.voxels[i], sv.colours[i])) {
+      kind[i] = 1;
+    } else if (colour && anchored[k] > 0 && !voxel_matched[i] && !voxel_revealed[i] &&
+               (chromaticity(sv.colours[i]) - anchor[k] / static_cast<float>(anchored[k])).norm() >
+                   static_cast<float>(kUnlike * settings.tracking.max_chroma_distance)) {
+      kind[i] = 2;
+    }
+    ++count[k][kind[i]];
+  }
+  std::vector<int> whole(n);
+  for (std::size_t k = 0; k < n; ++k) whole[k] = static_cast<int>(k);
+  std::vector<std::array<int, 3>> piece(n, {-1, -1, -1});
+  for (std::size_t k = 0; k < n; ++k) {
+    for (int c = 1; c <= 2; ++c) {
+      if (count[k][0] > 0 && count[k][static_cast<std::size_t>(c)] > 0) {
+        piece[k][static_cast<std::size_t>(c)] = static_cast<int>(whole.size());
+        whole.push_back(static_cast<int>(k));
+      }
+    }
+  }
+  if (whole.size() == n) return false;
   std::vector<int> owner = sv.owner;
   for (std::size_t i = 0; i < owner.size(); ++i) {
-    const int p = piece[static_cast<std::size_t>(owner[i])];
-    if (on[i] && p >= 0) owner[i] = p;
+    const int p = kind[i] == 0 ? -1 : piece[static_cast<std::size_t>(owner[i])][kind[i]];
+    if (p >= 0) owner[i] = p;
   }
   cut_supervoxels(frame, std::move(owner), whole);
   return true;

@@ -74,9 +74,9 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   const bool tracked = !labelled && initialised;
   std::vector<char> object =
       labelled ? labelled_object(frame, r) : initialised ? track(frame, r) : select(frame, r, why);
-  // Tracking never takes the support plane's voxels; a supervoxel that
-  // straddles the object's foot and the plane gives them up.
-  if (tracked && split_at_plane(frame, object)) {
+  // A supervoxel that straddles the object and the plane at its foot, or a
+  // hand at its edge, gives up the voxels tracking would not take.
+  if (tracked && split_off_others(frame, object)) {
     r.supervoxels = sv.supervoxels;
     r.voxel_owner = sv.owner;
     object.resize(r.supervoxels.size(), 0);

@@ -81,7 +81,12 @@ struct TrackingSettings {
   /// object and a touching hand of another colour out; <= 0 turns it off.
   /// A matched voxel is remembered with the chromaticity it matched, so a
   /// voxel mixing two colours cannot lead the next frame's match a step
-  /// further towards a touching hand's.
+  /// further towards a touching hand's. A supervoxel that joins the object
+  /// gives up its voxels that match nothing remembered, were not revealed
+  /// (grow_revealed) and are unlike, by more than twice this, the
+  /// chromaticity its matched voxels remember: a hand's where VCCS merged it
+  /// with the case's edge (as it gives up the support plane's,
+  /// plane_distance).
   double max_chroma_distance = 0.06;
   /// The object is lost when fewer of its voxels than this fraction of what
   /// the view can show are found: the first frame's count, or fewer where
@@ -140,9 +145,10 @@ struct TrackingSettings {
   /// the object rests on. Nor are voxels on the plane of the plane's colour
   /// (its mean chromaticity, within max_chroma_distance): an object
   /// supervoxel that straddles the object's foot and the plane gives them up
-  /// (a piece of its own). Over 81 episodes (27 scenarios, 3 seeds) the
+  /// (a piece of its own). With that and the colour's cut
+  /// (max_chroma_distance), over 81 episodes (27 scenarios, 3 seeds) the
   /// frames with half the object in view and an object precision below 0.99
-  /// went from 341 to 88 of 10 069 (docs/perception.md).
+  /// went from 341 to 3 of 10 070 (docs/perception.md).
   double plane_distance = 0.01;
   /// Smallest cluster accepted by the default start [supervoxels].
   int min_cluster_supervoxels = 3;
