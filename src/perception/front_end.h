@@ -232,6 +232,7 @@ struct Perception::Impl {
     }
   } grip;
   detail::PointGrid holder_grid;
+  detail::PointGrid base_grid;  // grow_holder(): the holder's body, for its base on the plane
   // classify(): the previous frame's occluder voxels off the support plane,
   // but for those of bodies that touched the object without coming as
   // occluders (`native`, grow_holder()); hashed in foreign_grid by
@@ -289,10 +290,8 @@ struct Perception::Impl {
   /// support plane (plane_voxel()), and those that neither match the
   /// remembered object (voxel_matched) nor were revealed and are unlike the
   /// colour its matched voxels remember (voxel_anchor; twice
-  /// max_chroma_distance).
-  /// Whether one was.
+  /// max_chroma_distance). Whether one was.
   bool split_off_others(const RgbdFrame& frame, const std::vector<char>& object);
-  detail::PointGrid base_grid;  // grow_holder(): the holder's body, for its base on the plane
   /// labelled.cpp: sv's supervoxels replaced by pieces: `owner` each voxel's
   /// piece, `whole` each piece's supervoxel before; a piece's centroid,
   /// colour and count from its voxels, its normal its own where it is a flat
