@@ -51,17 +51,15 @@ bool Perception::Impl::split_off_others(const RgbdFrame& frame, const std::vecto
   // were revealed and are unlike the colour its matched voxels remember
   // (kind 2, kUnlike: a hand's, where VCCS merged it with the case's edge):
   // a piece of each kind after the supervoxels, where some of it is left.
+  // (track() set voxel_matched, voxel_anchor and voxel_revealed for every voxel.)
   const std::size_t n = sv.supervoxels.size();
-  const bool colour = voxel_anchor.size() == sv.voxels.size();
   std::vector<Eigen::Vector3f> anchor(n, Eigen::Vector3f::Zero());
   std::vector<int> anchored(n, 0);
-  if (colour) {
-    for (std::size_t i = 0; i < sv.voxels.size(); ++i) {
-      const auto k = static_cast<std::size_t>(sv.owner[i]);
-      if (object[k] && voxel_matched[i]) {
-        anchor[k] += voxel_anchor[i];
-        ++anchored[k];
-      }
+  for (std::size_t i = 0; i < sv.voxels.size(); ++i) {
+    const auto k = static_cast<std::size_t>(sv.owner[i]);
+    if (object[k] && voxel_matched[i]) {
+      anchor[k] += voxel_anchor[i];
+      ++anchored[k];
     }
   }
   std::vector<std::uint8_t> kind(sv.voxels.size(), 0);
@@ -71,7 +69,7 @@ bool Perception::Impl::split_off_others(const RgbdFrame& frame, const std::vecto
     if (!object[k]) continue;
     if (plane_voxel(sv.voxels[i], sv.colours[i])) {
       kind[i] = 1;
-    } else if (colour && anchored[k] > 0 && !voxel_matched[i] && !voxel_revealed[i] &&
+    } else if (anchored[k] > 0 && !voxel_matched[i] && !voxel_revealed[i] &&
                (chromaticity(sv.colours[i]) - anchor[k] / static_cast<float>(anchored[k])).norm() >
                    static_cast<float>(kUnlike * settings.tracking.max_chroma_distance)) {
       kind[i] = 2;
