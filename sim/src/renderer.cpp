@@ -267,28 +267,37 @@ void add_noise(RgbdFrame& f, int row0, int row1, const std::vector<std::uint8_t>
   const CameraIntrinsics& k = f.intrinsics;
   const NormalByQuantiles& gauss = standard_normal();
   const std::uint64_t frame_key = mix64(mix64(seed) + static_cast<std::uint64_t>(frame_index));
+  // Plain pointers: the byte loads and stores would otherwise make the
+  // compiler load each vector's data pointer again at every pixel.
+  const float* const in = clean.data();
+  const std::uint8_t* const grazes = grazing.data();
+  const std::uint16_t* const labels = f.labels.data();
+  float* const out = f.depth.data();
+  const double* const dark_of = dropout.data();
+  const std::size_t dark_labels = dropout.size();
+  const int width = k.width, height = k.height;
+  const double edge_jump = m.edge_jump, depth_sigma = m.depth_sigma, edge_dropout = m.edge_dropout;
   for (int v = row0; v < row1; ++v) {
-    for (int u = 0; u < k.width; ++u) {
-      const std::size_t i = f.index(u, v);
-      const float z = clean[i];
+    const std::size_t row = f.index(0, v);
+    for (int u = 0; u < width; ++u) {
+      const std::size_t i = row + static_cast<std::size_t>(u);
+      const float z = in[i];
       if (z <= 0.0f) continue;
-      bool edge = false;
-      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
-        const int uu = u + du, vv = v + dv;
-        if (uu < 0 || vv < 0 || uu >= k.width || vv >= k.height) continue;
-        const float zn = clean[f.index(uu, vv)];
-        edge = edge || zn <= 0.0f || std::abs(zn - z) > m.edge_jump;
-      }
+      // Right, left, down, up, as far as the image goes.
+      const auto jumps = [&](std::size_t j) { return in[j] <= 0.0f || std::abs(in[j] - z) > edge_jump; };
+      const bool edge = (u + 1 < width && jumps(i + 1)) || (u > 0 && jumps(i - 1)) ||
+                        (v + 1 < height && jumps(i + static_cast<std::size_t>(width))) ||
+                        (v > 0 && jumps(i - static_cast<std::size_t>(width)));
       // Bits 0-31: the Gaussian; 32-55: the edge's drop-out; a second word
       // for a dark or shiny body's own drop-outs.
       const std::uint64_t bits = mix64(frame_key + kGolden * (static_cast<std::uint64_t>(i) + 1));
-      const double noise_z = gauss(static_cast<std::uint32_t>(bits)) * m.depth_sigma * z * z;
-      const double dark = f.labels[i] < dropout.size() ? dropout[f.labels[i]] : 0.0;
-      if (grazing[i] != 0 || (edge && uniform24(bits >> 32) < m.edge_dropout) ||
+      const double noise_z = gauss(static_cast<std::uint32_t>(bits)) * depth_sigma * z * z;
+      const double dark = labels[i] < dark_labels ? dark_of[labels[i]] : 0.0;
+      if (grazes[i] != 0 || (edge && uniform24(bits >> 32) < edge_dropout) ||
           (dark > 0.0 && uniform24(mix64(bits)) < dark)) {
-        f.depth[i] = 0.0f;
+        out[i] = 0.0f;
       } else {
-        f.depth[i] = quantised(static_cast<float>(z + noise_z));
+        out[i] = quantised(static_cast<float>(z + noise_z));
       }
     }
   }
@@ -706,6 +715,14 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
       rh.ray.flags[j] = 0;
     }
     const float tfar = static_cast<float>(sensor.max_depth);
+    // Plain pointers: the byte stores would otherwise make the compiler
+    // load each vector's data pointer again at every pixel.
+    float* const depth = f.depth.data();
+    std::uint8_t* const grazes = grazing.data();
+    std::uint16_t* const labels = f.labels.data();
+    std::uint8_t* const rgb = f.rgb.data();
+    const std::uint16_t* const body_label = impl_->labels.data();
+    const Body* const bodies = scenario_.bodies.data();
     for (int v = row0; v < row1; ++v) {
       const Eigen::Vector3d row_term = R.col(1) * ((v - k.cy) / k.fy);
       for (int u0 = 0; u0 < k.width; u0 += kPacket) {
@@ -728,13 +745,13 @@ void Renderer::render(const Eigen::Isometry3d& wMc, long frame_index, const Came
           const Eigen::Vector3d ng(rh.hit.Ng_x[j], rh.hit.Ng_y[j], rh.hit.Ng_z[j]);
           const Eigen::Vector3d d(rh.ray.dir_x[j], rh.ray.dir_y[j], rh.ray.dir_z[j]);
           const double c = std::abs(ng.normalized().dot(d.normalized()));
-          f.depth[i] = rh.ray.tfar[j];
-          grazing[i] = static_cast<float>(c) < cos_grazing ? 1 : 0;
-          f.labels[i] = impl_->labels[geom];
-          const Eigen::Vector3f colour = scenario_.bodies[geom].colour;
+          depth[i] = rh.ray.tfar[j];
+          grazes[i] = static_cast<float>(c) < cos_grazing ? 1 : 0;
+          labels[i] = body_label[geom];
+          const Eigen::Vector3f colour = bodies[geom].colour;
           const float shade = static_cast<float>(0.35 + 0.65 * c);
           for (int ch = 0; ch < 3; ++ch) {
-            f.rgb[3 * i + static_cast<std::size_t>(ch)] =
+            rgb[3 * i + static_cast<std::size_t>(ch)] =
                 static_cast<std::uint8_t>(std::clamp(255.0f * colour[ch] * shade, 0.0f, 255.0f));
           }
         }
