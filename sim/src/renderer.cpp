@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <map>
 #include <cstdint>
 #include <cmath>
 #include <functional>
@@ -30,6 +31,9 @@ constexpr double kDegToRad = kPi / 180.0;
 // times the single-precision rounding of coordinates around half a metre
 // (6e-8 m), where the simulated scenes are.
 constexpr double kSurfaceClearance = 1e-6;
+// A holder is the object's (interacting) while its surface comes this near
+// the object's; apart from it, an occluder like any other body [m].
+constexpr double kHolderContact = 0.01;
 
 // A point on a mesh: triangle and barycentric coordinates (stays on the
 // surface when the mesh moves or deforms).
@@ -309,7 +313,8 @@ struct Renderer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<TriangleMesh> world;               // per body, at the current time
-  std::vector<std::uint16_t> labels;             // per body
+  std::vector<std::uint16_t> labels;             // per body, at the current time (a holder's: set_time())
+  std::vector<std::uint16_t> apart_label;        // per body: a holder's label while it does not touch the object
   std::vector<double> dropout;                   // per label: Body::dropout
   std::vector<std::vector<SurfaceSample>> samples;  // per body
   int object = 0;
@@ -321,6 +326,46 @@ struct Renderer::Impl {
   ~Impl() {
     if (scene != nullptr) rtcReleaseScene(scene);
     if (device != nullptr) rtcReleaseDevice(device);
+  }
+
+  // Whether body b is an occluder at the current time: one of the
+  // scenario's, or a holder apart from the object.
+  [[nodiscard]] bool occluder_now(std::size_t b) const { return labels[b] >= kLabelOccluder0; }
+
+  // Whether body b's surface comes within kHolderContact of the object's
+  // at the current time (their surface samples, hashed in cells that size).
+  [[nodiscard]] bool touches_object(std::size_t b) const {
+    const auto obj = static_cast<std::size_t>(object);
+    if (!boxes[b].intersects(Eigen::AlignedBox3d(boxes[obj].min().array() - kHolderContact,
+                                                 boxes[obj].max().array() + kHolderContact))) {
+      return false;
+    }
+    const auto cell = [](const Eigen::Vector3d& p) {
+      return std::array<long, 3>{static_cast<long>(std::floor(p.x() / kHolderContact)),
+                                 static_cast<long>(std::floor(p.y() / kHolderContact)),
+                                 static_cast<long>(std::floor(p.z() / kHolderContact))};
+    };
+    std::map<std::array<long, 3>, std::vector<Eigen::Vector3d>> cells;
+    for (const SurfaceSample& x : samples[obj]) {
+      const Eigen::Vector3d p = position_of(world[obj], x);
+      cells[cell(p)].push_back(p);
+    }
+    for (const SurfaceSample& x : samples[b]) {
+      const Eigen::Vector3d p = position_of(world[b], x);
+      const std::array<long, 3> c = cell(p);
+      for (long dx = -1; dx <= 1; ++dx) {
+        for (long dy = -1; dy <= 1; ++dy) {
+          for (long dz = -1; dz <= 1; ++dz) {
+            const auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+            if (it == cells.end()) continue;
+            for (const Eigen::Vector3d& q : it->second) {
+              if ((q - p).squaredNorm() <= kHolderContact * kHolderContact) return true;
+            }
+          }
+        }
+      }
+    }
+    return false;
   }
 
   // The object's surface samples at the current time.
@@ -597,11 +642,19 @@ Renderer::Renderer(const Scenario& scenario, int surface_samples)
   impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) throw std::runtime_error("Embree: cannot create a device");
   int occluder = 0;
+  for (const Body& b : scenario_.bodies) occluder += b.role == Role::Occluder ? 1 : 0;
+  int holder = 0, occluder_index = 0;
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
     const Body& b = scenario_.bodies[k];
-    impl_->labels.push_back(label_of(b, b.role == Role::Occluder ? occluder++ : 0));
-    if (impl_->dropout.size() <= impl_->labels.back()) impl_->dropout.resize(impl_->labels.back() + 1u, 0.0);
-    impl_->dropout[impl_->labels.back()] = std::max(impl_->dropout[impl_->labels.back()], b.dropout);
+    impl_->labels.push_back(label_of(b, b.role == Role::Occluder ? occluder_index++ : 0));
+    // A holder apart from the object is an occluder, numbered after the scenario's.
+    impl_->apart_label.push_back(b.role == Role::Interacting
+                                     ? static_cast<std::uint16_t>(kLabelOccluder0 + occluder + holder++)
+                                     : impl_->labels.back());
+    for (const std::uint16_t label : {impl_->labels.back(), impl_->apart_label.back()}) {
+      if (impl_->dropout.size() <= label) impl_->dropout.resize(label + 1u, 0.0);
+      impl_->dropout[label] = std::max(impl_->dropout[label], b.dropout);
+    }
     if (b.role == Role::Object) impl_->object = static_cast<int>(k);
     impl_->rigid_convex.push_back(!b.deformable() && convex(b.mesh) ? 1 : 0);
     const int n = b.role == Role::Object ? surface_samples
@@ -649,6 +702,11 @@ void Renderer::set_time(double t) {
     rtcReleaseGeometry(g);
   }
   rtcCommitScene(impl_->scene);
+  for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
+    if (scenario_.bodies[k].role == Role::Interacting) {
+      impl_->labels[k] = impl_->touches_object(k) ? std::uint16_t{kLabelInteracting} : impl_->apart_label[k];
+    }
+  }
 }
 
 RenderedFrame Renderer::render(const Eigen::Isometry3d& wMc, long frame_index) const {
@@ -775,7 +833,7 @@ ObjectTruth Renderer::truth(const Eigen::Isometry3d& wMc, double r_sphere) const
   t.centroid = object_centroid();
   t.visible_fraction = impl_->visible_fraction(impl_->object_samples(), wMc, scenario_.sensor);
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
-    if (scenario_.bodies[b].role != Role::Occluder) continue;
+    if (!impl_->occluder_now(b)) continue;
     const auto& verts = impl_->world[b].vertices;
     const bool inside = std::any_of(verts.begin(), verts.end(), [&](const Eigen::Vector3f& v) {
       return (v.cast<double>() - t.centroid).norm() < r_sphere;
@@ -876,14 +934,15 @@ ViewProblem Renderer::ground_truth_problem(const Eigen::Isometry3d& wMc, double 
   const Eigen::Vector3d half = (axes.transpose() * centred).cwiseAbs().rowwise().maxCoeff().array() + obb_margin;
   const Eigen::Vector3d c = p.positions.cols() > 0 ? Eigen::Vector3d(p.positions.rowwise().mean()) : mean;
 
-  // Everything but the object and its holder (inside the augmented OBB
-  // anyway): the occluders and the table, as the paper's classification
-  // would; not the bodies wholly outside the sphere.
+  // Everything but the object and its holder while it touches the object
+  // (inside the augmented OBB anyway): the occluders (a holder apart from
+  // the object is one) and the table, as the paper's classification would;
+  // not the bodies wholly outside the sphere.
   std::vector<std::size_t> bodies;
   std::size_t samples = 0;
   for (std::size_t b = 0; b < scenario_.bodies.size(); ++b) {
     const Role role = scenario_.bodies[b].role;
-    if ((role != Role::Occluder && role != Role::Background) || impl_->boxes[b].exteriorDistance(c) > r_sphere + 1e-9) {
+    if ((!impl_->occluder_now(b) && role != Role::Background) || impl_->boxes[b].exteriorDistance(c) > r_sphere + 1e-9) {
       continue;
     }
     bodies.push_back(b);

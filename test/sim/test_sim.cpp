@@ -285,6 +285,39 @@ TEST(Renderer, LabelsNameWhatEachPixelSees) {
   EXPECT_EQ(f.frame.depth[f.frame.index(2, 2)], 0.0f);
 }
 
+TEST(Renderer, AHolderApartFromTheObjectIsAnOccluder) {
+  // A hand that comes to take the object: an occluder like any other body
+  // until it touches the object (within 1 cm), then the object's holder.
+  const Scenario s = wall_scene(1.0,
+      "occluders: [{shape: box, size: [0.05, 0.05, 0.05], position: [0, 0, 0.5]}]\n"
+      "holder: {shape: sphere, radius: 0.02, waypoints: [{t: 0, position: [0.3, 0, 1.0]},\n"
+      "                                                  {t: 1, position: [0.125, 0, 1.0]}]}\n");
+  Renderer r(s);
+  const CameraIntrinsics& k = s.sensor.intrinsics;
+  const auto label_at = [&](const RenderedFrame& f, const Eigen::Vector3d& p) {
+    const int u = static_cast<int>(std::lround(k.fx * p.x() / p.z() + k.cx));
+    const int v = static_cast<int>(std::lround(k.fy * p.y() / p.z() + k.cy));
+    return f.frame.labels[f.frame.index(u, v)];
+  };
+  // The ground-truth problem's occluder cells within 3 cm of the holder's centre.
+  const auto cells_near = [&](const Eigen::Vector3d& centre) {
+    const ViewProblem p = r.ground_truth_problem(s.wMc_start, 0.02, 0.5, 0.02);
+    int n = 0;
+    for (Eigen::Index j = 0; j < p.occluders.cols(); ++j) n += (p.occluders.col(j) - centre).norm() < 0.03 ? 1 : 0;
+    return n;
+  };
+  r.set_time(0.0);  // 18 cm from the wall's edge
+  EXPECT_EQ(label_at(r.render(s.wMc_start, 0), {0.3, 0.0, 0.98}), kLabelOccluder0 + 1);
+  EXPECT_EQ(r.truth(s.wMc_start, 0.5).occluders_in_sphere, 2);
+  EXPECT_GT(cells_near({0.3, 0.0, 1.0}), 0);
+  r.set_time(0.9);  // 2.25 cm from it
+  EXPECT_EQ(label_at(r.render(s.wMc_start, 1), {0.1425, 0.0, 0.98}), kLabelOccluder0 + 1);
+  r.set_time(1.0);  // 5 mm from it
+  EXPECT_EQ(label_at(r.render(s.wMc_start, 2), {0.125, 0.0, 0.98}), kLabelInteracting);
+  EXPECT_EQ(r.truth(s.wMc_start, 0.5).occluders_in_sphere, 1);
+  EXPECT_EQ(cells_near({0.125, 0.0, 1.0}), 0);
+}
+
 TEST(Truth, VisibleFractionOnHandComputedCases) {
   const double r_sphere = 0.5;
   {  // fully visible
