@@ -93,16 +93,17 @@ void Perception::Impl::grow_revealed(const RgbdFrame& frame, const PerceptionRes
   // - hidden: behind a surface nearer its camera by more than max_motion.
   //   The voxel is the object's when that surface was the object (a
   //   remembered voxel of the voxel's chromaticity: its own fold hid it).
-  // - unseen: beyond its image, or on a surface that faced its camera at
-  //   less than kGrazing (seen edge-on or from behind: the top of a box the
-  //   camera rises over, a part the first image cut). Nothing tells whose
-  //   it is but what it touches: the object's when its component (below)
-  //   touches the object through a neighbour of the object's colour.
+  // - unseen: beyond its image, on a pixel it had no depth for, or on a
+  //   surface that faced its camera at less than kGrazing (seen edge-on or
+  //   from behind: the top of a box the camera rises over, whose grazing
+  //   pixels a sensor drops; a part the first image cut). Nothing tells
+  //   whose it is but what it touches: the object's when its component
+  //   (below) touches the object through a neighbour of the object's colour.
   const Eigen::Isometry3d cMw = previous.wMc.inverse();
   const Eigen::Vector3d eye = previous.wMc.translation();
   std::vector<int> seen_before(n, 0);  // voxels the previous frame showed where they are, not edge-on
   std::vector<int> revealed(n, 0);     // voxels the object hid from it
-  std::vector<int> unseen(n, 0);       // voxels beyond its image or edge-on to it
+  std::vector<int> unseen(n, 0);       // voxels beyond its image, without depth or edge-on to it
   std::vector<char> voxel_state(r.voxels.size(), 0);  // 1 hidden by the object, 2 unseen
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     const auto owner = static_cast<std::size_t>(r.voxel_owner[i]);
@@ -110,7 +111,11 @@ void Perception::Impl::grow_revealed(const RgbdFrame& frame, const PerceptionRes
     if (object[owner] || plane_voxel(r.voxels[i], sv.colours[i])) continue;
     const Eigen::Vector3d p = r.voxels[i].cast<double>();
     const auto l = detail::look(previous, cMw, p);
-    if (l && !l->measured()) continue;  // a drop-out tells nothing
+    if (l && !l->measured()) {
+      voxel_state[i] = 2;
+      ++unseen[owner];
+      continue;
+    }
     const double d = l ? static_cast<double>(l->observed) : 0.0;
     if (l && d < l->z - t.max_motion) {
       const Eigen::Vector3f hider = detail::unproject(previous, l->u, l->v, d).cast<float>();
