@@ -51,13 +51,14 @@ bool Perception::Impl::split_off_others(const RgbdFrame& frame, const std::vecto
   // were revealed and are unlike the colour its matched voxels remember
   // (kind 2, kUnlike: a hand's, where VCCS merged it with the case's edge):
   // a piece of each kind after the supervoxels, where some of it is left.
-  // (track() set voxel_matched, voxel_anchor and voxel_revealed for every voxel.)
+  // (track() set voxel_matched, voxel_anchor and voxel_revealed for every
+  // voxel; after select(), which sets no anchor, only the plane's go.)
   const std::size_t n = sv.supervoxels.size();
   std::vector<Eigen::Vector3f> anchor(n, Eigen::Vector3f::Zero());
   std::vector<int> anchored(n, 0);
   for (std::size_t i = 0; i < sv.voxels.size(); ++i) {
     const auto k = static_cast<std::size_t>(sv.owner[i]);
-    if (object[k] && voxel_matched[i]) {
+    if (object[k] && voxel_matched[i] && !voxel_anchor.empty()) {
       anchor[k] += voxel_anchor[i];
       ++anchored[k];
     }

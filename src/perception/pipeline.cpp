@@ -71,12 +71,12 @@ PerceptionResult Perception::Impl::process(const RgbdFrame& frame) {
   std::string why;
   voxel_revealed.assign(r.voxels.size(), 0);  // only track() finds revealed surface
   voxel_anchor.clear();                         // nor matches a remembered chromaticity
-  const bool tracked = !labelled && initialised;
   std::vector<char> object =
       labelled ? labelled_object(frame, r) : initialised ? track(frame, r) : select(frame, r, why);
-  // A supervoxel that straddles the object and the plane at its foot, or a
-  // hand at its edge, gives up the voxels tracking would not take.
-  if (tracked && split_off_others(frame, object)) {
+  // A supervoxel that straddles the object and the plane at its foot, or
+  // (once tracked) a hand at its edge, gives up the voxels tracking would
+  // not take.
+  if (!labelled && split_off_others(frame, object)) {
     r.supervoxels = sv.supervoxels;
     r.voxel_owner = sv.owner;
     object.resize(r.supervoxels.size(), 0);

@@ -63,11 +63,16 @@ TEST(Perception, DefaultSelectionFindsTheCaseOnTheTable) {
   EXPECT_GT(std::abs(r.axes.col(0).dot(Eigen::Vector3d::UnitX())), 0.95);
   EXPECT_GT(std::abs(r.axes.col(2).dot(Eigen::Vector3d::UnitY())), 0.95);
   EXPECT_NEAR(r.axes.determinant(), 1.0, 1e-9);
-  // The augmented OBB holds every object voxel.
+  // The augmented OBB holds every object voxel, and every one is the
+  // case's: a supervoxel straddling its foot and the table gives up the
+  // table's voxels from the first frame.
+  const Eigen::AlignedBox3d case_box(kCaseCentre - Eigen::Vector3d(0.099, 0.0115, 0.0715),
+                                     kCaseCentre + Eigen::Vector3d(0.099, 0.0115, 0.0715));
   for (std::size_t i = 0; i < r.voxels.size(); ++i) {
     if (r.supervoxels[static_cast<std::size_t>(r.voxel_owner[i])].label ==
         perception::SupervoxelClass::Object) {
       ASSERT_TRUE(r.obb.contains(r.voxels[i].cast<double>()));
+      EXPECT_TRUE(case_box.contains(r.voxels[i].cast<double>())) << r.voxels[i].transpose();
     }
   }
 }
