@@ -11,6 +11,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cstdint>
+
 namespace {
 
 /// 320x240, 640x480 (4:3, 615 px focal length at 640) or 1280x720 (16:9, the same field across).
@@ -84,7 +87,17 @@ BENCHMARK(BM_PerceptionPclSupervoxels)->Arg(640)->Arg(320)->Arg(1280)->Unit(benc
 void BM_PerceptionScores(benchmark::State& state) {
   std::vector<int> labels;
   ofv::RgbdFrame frame = scene_frame(static_cast<int>(state.range(0)), &labels);
-  frame.labels.assign(labels.begin(), labels.end());  // the synthetic scene's own label values
+  // The synthetic scene's labels as the simulator's: the case the object,
+  // the table its support, the hands occluding bodies.
+  frame.labels.resize(labels.size());
+  std::transform(labels.begin(), labels.end(), frame.labels.begin(), [](int l) -> std::uint16_t {
+    switch (l) {
+      case ofv::test::kObject: return ofv::kPixelObject;
+      case ofv::test::kTable: return ofv::kPixelSupport;
+      case ofv::test::kNone: return ofv::kPixelNone;
+      default: return static_cast<std::uint16_t>(ofv::kPixelOccluder0 + l);
+    }
+  });
   const ofv::perception::PerceptionSettings settings;
   ofv::perception::Perception perception{settings};
   (void)perception.process(frame);

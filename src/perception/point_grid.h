@@ -109,16 +109,32 @@ class PointGrid {
     }
   }
 
-  /// True if a point j within `radius` (<= the cell size) of p has accept(j).
+  /// True if a point j within `radius` (<= the cell size) of p has accept(j)
+  /// (without side effects: the search stops at the first such point, p's
+  /// own cell first).
   template <typename Accept>
   [[nodiscard]] bool any_within(const Eigen::Vector3f& p, float radius, Accept&& accept) const {
     const float r2 = radius * radius;
-    bool found = false;
-    for_each_near(p, [&](int j) {
-      found =
-          found || (((*points_)[static_cast<std::size_t>(j)] - p).squaredNorm() <= r2 && accept(j));
-    });
-    return found;
+    const Eigen::Vector3i c = cell_of(p);
+    const auto in_cell = [&](const Eigen::Vector3i& cell) {
+      const std::uint64_t k = key(cell);
+      const int first = first_.find(k);
+      if (first < 0) return false;
+      for (auto i = static_cast<std::size_t>(first); i < entries_.size() && entries_[i].key == k; ++i) {
+        const int j = entries_[i].index;
+        if (((*points_)[static_cast<std::size_t>(j)] - p).squaredNorm() <= r2 && accept(j)) return true;
+      }
+      return false;
+    };
+    if (in_cell(c)) return true;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if ((dx != 0 || dy != 0 || dz != 0) && in_cell(c + Eigen::Vector3i(dx, dy, dz))) return true;
+        }
+      }
+    }
+    return false;
   }
 
   /// Calls f(j) for every point j within the 27 cells around p.

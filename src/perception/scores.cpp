@@ -73,15 +73,29 @@ VoxelLabels::VoxelLabels(const RgbdFrame& frame, double voxel, int stride, doubl
   // votes in the pixels' order (the cells' sums as one loop would add them).
   const int rows = (k.height + stride - 1) / stride, columns = (k.width + stride - 1) / stride;
   constexpr std::uint64_t kNoPoint = ~std::uint64_t{0};
-  std::vector<std::uint64_t> keys(static_cast<std::size_t>(rows) * static_cast<std::size_t>(columns), kNoPoint);
-  std::vector<Eigen::Vector3f> points(keys.size());
+  // Scratch kept by the calling thread (a frame's worth of pages each call
+  // otherwise; the workers below use the caller's, through these
+  // references), and each column's and row's ray slope, made once.
+  thread_local std::vector<std::uint64_t> keys_scratch;
+  thread_local std::vector<Eigen::Vector3f> points_scratch;
+  thread_local std::vector<float> slope_x_scratch, slope_y_scratch;
+  std::vector<std::uint64_t>& keys = keys_scratch;
+  std::vector<Eigen::Vector3f>& points = points_scratch;
+  std::vector<float>& slope_x = slope_x_scratch;
+  std::vector<float>& slope_y = slope_y_scratch;
+  keys.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(columns), kNoPoint);
+  points.resize(keys.size());
+  slope_x.resize(static_cast<std::size_t>(columns));
+  slope_y.resize(static_cast<std::size_t>(rows));
+  for (int c = 0; c < columns; ++c) slope_x[static_cast<std::size_t>(c)] = static_cast<float>((c * stride - k.cx) / k.fx);
+  for (int r = 0; r < rows; ++r) slope_y[static_cast<std::size_t>(r)] = static_cast<float>((r * stride - k.cy) / k.fy);
   detail::for_each_index(static_cast<std::size_t>(rows), 8, [&](std::size_t row) {
     const int v = static_cast<int>(row) * stride;
+    const float* const depth = frame.depth.data() + frame.index(0, v);
     for (int u = 0; u < k.width; u += stride) {
-      const std::size_t i = frame.index(u, v);
-      const float z = frame.depth[i];
+      const float z = depth[u];
       if (!(z > 0.0f) || !std::isfinite(z) || z > static_cast<float>(max_depth)) continue;
-      const Eigen::Vector3f pc(static_cast<float>((u - k.cx) / k.fx) * z, static_cast<float>((v - k.cy) / k.fy) * z, z);
+      const Eigen::Vector3f pc(slope_x[static_cast<std::size_t>(u / stride)] * z, slope_y[row] * z, z);
       const std::size_t at = row * static_cast<std::size_t>(columns) + static_cast<std::size_t>(u / stride);
       points[at] = wRc * pc + wtc;
       keys[at] = detail::cell_key(detail::cell_of(points[at], inv_voxel_));
