@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <cstdint>
 #include <cmath>
 #include <functional>
@@ -333,39 +332,28 @@ struct Renderer::Impl {
   [[nodiscard]] bool occluder_now(std::size_t b) const { return labels[b] >= kLabelOccluder0; }
 
   // Whether body b's surface comes within kHolderContact of the object's
-  // at the current time (their surface samples, hashed in cells that size).
+  // at the current time: their surface samples, those of each within that
+  // of the other's bounding box.
   [[nodiscard]] bool touches_object(std::size_t b) const {
     const auto obj = static_cast<std::size_t>(object);
-    if (!boxes[b].intersects(Eigen::AlignedBox3d(boxes[obj].min().array() - kHolderContact,
-                                                 boxes[obj].max().array() + kHolderContact))) {
-      return false;
-    }
-    const auto cell = [](const Eigen::Vector3d& p) {
-      return std::array<long, 3>{static_cast<long>(std::floor(p.x() / kHolderContact)),
-                                 static_cast<long>(std::floor(p.y() / kHolderContact)),
-                                 static_cast<long>(std::floor(p.z() / kHolderContact))};
+    const auto grown = [](const Eigen::AlignedBox3d& box) {
+      return Eigen::AlignedBox3d(box.min().array() - kHolderContact, box.max().array() + kHolderContact);
     };
-    std::map<std::array<long, 3>, std::vector<Eigen::Vector3d>> cells;
-    for (const SurfaceSample& x : samples[obj]) {
-      const Eigen::Vector3d p = position_of(world[obj], x);
-      cells[cell(p)].push_back(p);
-    }
-    for (const SurfaceSample& x : samples[b]) {
-      const Eigen::Vector3d p = position_of(world[b], x);
-      const std::array<long, 3> c = cell(p);
-      for (long dx = -1; dx <= 1; ++dx) {
-        for (long dy = -1; dy <= 1; ++dy) {
-          for (long dz = -1; dz <= 1; ++dz) {
-            const auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
-            if (it == cells.end()) continue;
-            for (const Eigen::Vector3d& q : it->second) {
-              if ((q - p).squaredNorm() <= kHolderContact * kHolderContact) return true;
-            }
-          }
-        }
+    if (!boxes[b].intersects(grown(boxes[obj]))) return false;
+    const auto near_box = [&](std::size_t body, const Eigen::AlignedBox3d& box) {
+      std::vector<Eigen::Vector3d> near;
+      for (const SurfaceSample& x : samples[body]) {
+        const Eigen::Vector3d p = position_of(world[body], x);
+        if (box.contains(p)) near.push_back(p);
       }
-    }
-    return false;
+      return near;
+    };
+    const std::vector<Eigen::Vector3d> mine = near_box(b, grown(boxes[obj]));
+    const std::vector<Eigen::Vector3d> its = near_box(obj, grown(boxes[b]));
+    return std::any_of(mine.begin(), mine.end(), [&](const Eigen::Vector3d& p) {
+      return std::any_of(its.begin(), its.end(),
+                         [&](const Eigen::Vector3d& q) { return (q - p).squaredNorm() <= kHolderContact * kHolderContact; });
+    });
   }
 
   // The object's surface samples at the current time.
