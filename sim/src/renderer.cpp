@@ -629,15 +629,15 @@ Renderer::Renderer(const Scenario& scenario, int surface_samples)
   // while a renderer lived.
   impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) throw std::runtime_error("Embree: cannot create a device");
-  int occluder = 0;
-  for (const Body& b : scenario_.bodies) occluder += b.role == Role::Occluder ? 1 : 0;
-  int holder = 0, occluder_index = 0;
+  const auto occluders = static_cast<int>(std::count_if(scenario_.bodies.begin(), scenario_.bodies.end(),
+                                                        [](const Body& b) { return b.role == Role::Occluder; }));
+  int occluder = 0, holder = 0;
   for (std::size_t k = 0; k < scenario_.bodies.size(); ++k) {
     const Body& b = scenario_.bodies[k];
-    impl_->labels.push_back(label_of(b, b.role == Role::Occluder ? occluder_index++ : 0));
+    impl_->labels.push_back(label_of(b, b.role == Role::Occluder ? occluder++ : 0));
     // A holder apart from the object is an occluder, numbered after the scenario's.
     impl_->apart_label.push_back(b.role == Role::Interacting
-                                     ? static_cast<std::uint16_t>(kLabelOccluder0 + occluder + holder++)
+                                     ? static_cast<std::uint16_t>(kLabelOccluder0 + occluders + holder++)
                                      : impl_->labels.back());
     for (const std::uint16_t label : {impl_->labels.back(), impl_->apart_label.back()}) {
       if (impl_->dropout.size() <= label) impl_->dropout.resize(label + 1u, 0.0);
